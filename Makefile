@@ -1,0 +1,48 @@
+# rccx: the commands of the README. Each installs what is missing first (scripts/install-deps).
+JOBS ?= 2
+DEBUG_DIR := build/debug
+RELEASE_DIR := build/release
+CMAKE ?= cmake
+
+.PHONY: all deps demo test bench build-debug build-release format format-check clean
+
+all: build-release
+
+deps:
+	@scripts/install-deps
+
+$(DEBUG_DIR)/CMakeCache.txt:
+	$(CMAKE) -S . -B $(DEBUG_DIR) -DCMAKE_BUILD_TYPE=Debug -DRCCX_SANITIZE=ON -DRCCX_BUILD_BENCHMARKS=OFF
+
+$(RELEASE_DIR)/CMakeCache.txt:
+	$(CMAKE) -S . -B $(RELEASE_DIR) -DCMAKE_BUILD_TYPE=Release -DRCCX_BUILD_TESTS=OFF
+
+build-debug: deps $(DEBUG_DIR)/CMakeCache.txt
+	$(CMAKE) --build $(DEBUG_DIR) -j$(JOBS)
+
+build-release: deps $(RELEASE_DIR)/CMakeCache.txt
+	$(CMAKE) --build $(RELEASE_DIR) -j$(JOBS)
+
+# The main example on simulated robots (for now: kinematics of the thesis's robots).
+demo: build-release
+	$(RELEASE_DIR)/examples/01_kinematics
+
+# Debug build with AddressSanitizer and UndefinedBehaviorSanitizer, then every test.
+test: build-debug
+	cd $(DEBUG_DIR) && ctest --output-on-failure -j$(JOBS)
+
+# Release benchmarks against Orocos KDL; JSON under bench-results/.
+bench: build-release
+	@mkdir -p bench-results
+	$(RELEASE_DIR)/bench/rccx_bench --benchmark_out=bench-results/kinematics.json \
+	  --benchmark_out_format=json --benchmark_repetitions=3 --benchmark_report_aggregates_only=true
+	@python3 scripts/bench-report bench-results/kinematics.json
+
+format:
+	git ls-files '*.cpp' '*.hpp' | xargs clang-format -i
+
+format-check:
+	git ls-files '*.cpp' '*.hpp' | xargs clang-format --dry-run --Werror
+
+clean:
+	rm -rf build

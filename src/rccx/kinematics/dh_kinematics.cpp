@@ -1,0 +1,72 @@
+#include "rccx/kinematics/dh_kinematics.hpp"
+
+#include <Eigen/Cholesky>
+#include <cmath>
+
+namespace rccx::kin {
+
+DhKinematics::DhKinematics(RobotModel model, DhSolverSettings settings)
+    : Kinematics(std::move(model)), settings_(settings) {}
+
+math::Transform DhKinematics::forward(const JointVector& q) const noexcept {
+  return chain_forward(q);
+}
+
+IkResult DhKinematics::inverse(const math::Transform& pose,
+                               const IkOptions& options) const noexcept {
+  IkResult result;
+  const auto reference = reference_pose(options);
+  if (!reference) return result;  // bad_input
+  for (double v : pose.rows()) {
+    if (!std::isfinite(v)) return result;
+  }
+  JointVector q = *reference;
+  const JointVector lower = model().lower(), upper = model().upper();
+  for (std::size_t i = 0; i < dof(); ++i) q[i] = std::clamp(q[i], lower[i], upper[i]);
+  const double lambda2 = settings_.damping * settings_.damping;
+  result.status = IkStatus::no_convergence;
+
+  for (int iteration = 0; iteration < settings_.max_iterations; ++iteration) {
+    const math::Transform T = chain_forward(q);
+    const math::Vec3 dp = pose.p - T.p;
+    // Orientation error as a rotation vector, in the base frame: R_target R^T.
+    math::Vec3 axis;
+    double angle = 0.0;
+    (pose.R * T.R.transposed()).to_axis_angle(axis, angle);
+    if (dp.norm() <= settings_.position_tolerance_m &&
+        angle <= settings_.orientation_tolerance_rad) {
+      result.status = IkStatus::ok;
+      break;
+    }
+    const math::Vec3 dw = axis * angle;
+    Eigen::Matrix<double, 6, 1> e;
+    e << dp.x, dp.y, dp.z, dw.x, dw.y, dw.z;
+    const Jacobian J = jacobian(q);
+    Eigen::Matrix<double, 6, 6> JJt = J * J.transpose();
+    JJt.diagonal().array() += lambda2;
+    const Eigen::Matrix<double, 6, 1> y = JJt.ldlt().solve(e);
+    Eigen::Matrix<double, Eigen::Dynamic, 1, Eigen::ColMajor, kMaxJoints, 1> dq = J.transpose() * y;
+    const double largest = dq.cwiseAbs().maxCoeff();
+    if (largest > settings_.max_step_rad_or_m) dq *= settings_.max_step_rad_or_m / largest;
+    bool moved = false;
+    for (std::size_t i = 0; i < dof(); ++i) {
+      const double next = std::clamp(q[i] + dq(static_cast<Eigen::Index>(i)), lower[i], upper[i]);
+      moved = moved || next != q[i];
+      q[i] = next;
+    }
+    if (!moved) {  // every step is blocked by a limit or the Jacobian lost rank
+      result.status = IkStatus::singular;
+      break;
+    }
+  }
+  if (result.status != IkStatus::ok) return result;
+  // Whole turns back towards the reference, when a joint's range allows.
+  if (!fit_to_limits(q, *reference)) {
+    result.status = IkStatus::joint_limits;
+    return result;
+  }
+  result.q = q;
+  return result;
+}
+
+}  // namespace rccx::kin

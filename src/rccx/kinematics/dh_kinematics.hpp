@@ -1,0 +1,32 @@
+// Kinematics of any serial chain given by its standard DH table: forward by the product of A
+// matrices, the geometric Jacobian, and a damped-least-squares inverse that keeps every joint
+// within its limits. Slower than a closed form and it finds one solution (near the seed), but it
+// serves every robot a data file can describe.
+#pragma once
+
+#include "rccx/kinematics/kinematics.hpp"
+
+namespace rccx::kin {
+
+struct DhSolverSettings {
+  int max_iterations = 100;
+  double position_tolerance_m = 1e-12;
+  double orientation_tolerance_rad = 1e-12;
+  double damping = 1e-4;             ///< lambda of (J Jt + lambda^2 I)
+  double max_step_rad_or_m = 0.5;    ///< largest joint change per iteration
+};
+
+class DhKinematics final : public Kinematics {
+ public:
+  explicit DhKinematics(RobotModel model, DhSolverSettings settings = {});
+
+  [[nodiscard]] math::Transform forward(const JointVector& q) const noexcept override;
+  /// Iterates from options.near (or the ready pose); options.configuration is not used.
+  [[nodiscard]] IkResult inverse(const math::Transform& pose,
+                                 const IkOptions& options = {}) const noexcept override;
+
+ private:
+  DhSolverSettings settings_;
+};
+
+}  // namespace rccx::kin

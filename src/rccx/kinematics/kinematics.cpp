@@ -1,0 +1,263 @@
+#include "rccx/kinematics/kinematics.hpp"
+
+#include <cmath>
+#include <limits>
+
+#include "rccx/kinematics/dh_kinematics.hpp"
+#include "rccx/kinematics/microbo_kinematics.hpp"
+#include "rccx/kinematics/puma_kinematics.hpp"
+#include "rccx/math/units.hpp"
+
+namespace rccx::kin {
+
+std::string_view to_string(IkStatus status) noexcept {
+  switch (status) {
+    case IkStatus::ok:
+      return "ok";
+    case IkStatus::out_of_reach:
+      return "out_of_reach";
+    case IkStatus::joint_limits:
+      return "joint_limits";
+    case IkStatus::singular:
+      return "singular";
+    case IkStatus::no_convergence:
+      return "no_convergence";
+    case IkStatus::bad_configuration:
+      return "bad_configuration";
+    case IkStatus::bad_input:
+      return "bad_input";
+  }
+  return "?";
+}
+
+std::string_view describe(IkStatus status) noexcept {
+  switch (status) {
+    case IkStatus::ok:
+      return "solved";
+    case IkStatus::out_of_reach:
+      return "out of reach: no joint values put T6 at this pose";
+    case IkStatus::joint_limits:
+      return "out of joint limits: the pose is reachable only with a joint outside its limits";
+    case IkStatus::singular:
+      return "singular: the Jacobian lost rank and the numeric solver could not leave it";
+    case IkStatus::no_convergence:
+      return "no convergence: the numeric solver did not reach the pose (unreachable, or try "
+             "another --near)";
+    case IkStatus::bad_configuration:
+      return "unknown configuration for this robot";
+    case IkStatus::bad_input:
+      return "bad input: the pose must be finite and --near must have one value per joint";
+  }
+  return "?";
+}
+
+std::string_view to_string(Singularity s) noexcept {
+  switch (s) {
+    case Singularity::none:
+      return "none";
+    case Singularity::shoulder:
+      return "shoulder";
+    case Singularity::elbow:
+      return "elbow";
+    case Singularity::wrist:
+      return "wrist";
+  }
+  return "?";
+}
+
+Kinematics::Kinematics(RobotModel model) : model_(std::move(model)) {
+  for (std::size_t i = 0; i < model_.dof(); ++i) {
+    const Joint& j = model_.joints[i];
+    links_[i] = {j.dh.a_m,         std::cos(j.dh.alpha_rad), std::sin(j.dh.alpha_rad),
+                 j.dh.d_m,         j.dh.theta_rad,           j.type == JointType::prismatic};
+    // cos(pi/2) is 6e-17, not 0; snap so that the DH chain is exact for the usual right angles.
+    if (std::abs(links_[i].ca) < 1e-15) links_[i].ca = 0.0;
+    if (std::abs(links_[i].sa) < 1e-15) links_[i].sa = 0.0;
+  }
+}
+
+std::optional<Configuration> Kinematics::find_configuration(std::string_view name) const noexcept {
+  const auto names = configuration_names();
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    if (names[i] == name) return Configuration{static_cast<std::uint8_t>(i)};
+  }
+  return std::nullopt;
+}
+
+std::string_view Kinematics::configuration_name(Configuration c) const noexcept {
+  const auto names = configuration_names();
+  return c.index < names.size() ? names[c.index] : std::string_view{};
+}
+
+std::optional<JointVector> Kinematics::reference_pose(const IkOptions& options) const noexcept {
+  if (!options.near) return model_.ready();
+  if (options.near->size() != dof()) return std::nullopt;
+  for (double v : *options.near) {
+    if (!std::isfinite(v)) return std::nullopt;
+  }
+  return *options.near;
+}
+
+bool Kinematics::fit_to_limits(JointVector& q, const JointVector& toward) const noexcept {
+  constexpr double kTurn = 2.0 * math::kPi;
+  for (std::size_t i = 0; i < dof(); ++i) {
+    const Joint& j = model_.joints[i];
+    const double lo = j.lower - kLimitTolerance;
+    const double hi = j.upper + kLimitTolerance;
+    double v = q[i];
+    if (j.type == JointType::revolute) {
+      // Whole turns that bring v within limits: k_lo..k_hi; the one nearest `toward` wins.
+      const double k_lo = std::ceil((lo - v) / kTurn);
+      const double k_hi = std::floor((hi - v) / kTurn);
+      if (k_lo > k_hi) return false;
+      const double k_near = std::round((toward[i] - v) / kTurn);
+      v += kTurn * std::clamp(k_near, k_lo, k_hi);
+    }
+    if (!(v >= lo && v <= hi)) return false;
+    q[i] = std::clamp(v, j.lower, j.upper);
+  }
+  return true;
+}
+
+namespace {
+
+bool finite_pose(const math::Transform& pose) noexcept {
+  for (double v : pose.rows()) {
+    if (!std::isfinite(v)) return false;
+  }
+  return true;
+}
+
+double squared_distance(const JointVector& a, const JointVector& b) noexcept {
+  double s = 0.0;
+  for (std::size_t i = 0; i < a.size(); ++i) s += (a[i] - b[i]) * (a[i] - b[i]);
+  return s;
+}
+
+}  // namespace
+
+IkSolutions Kinematics::inverse_all(const math::Transform& pose,
+                                    const IkOptions& options) const noexcept {
+  IkSolutions all;
+  const IkResult one = inverse(pose, options);
+  if (one) {
+    all.items[0] = one;
+    all.count = 1;
+  } else {
+    all.status = one.status;
+  }
+  return all;
+}
+
+IkResult AnalyticKinematics::inverse(const math::Transform& pose,
+                                     const IkOptions& options) const noexcept {
+  IkResult best;
+  const auto reference = reference_pose(options);
+  if (!reference || !finite_pose(pose)) return best;  // bad_input
+  const auto names = configuration_names();
+  if (options.configuration) {
+    if (options.configuration->index >= names.size()) {
+      best.status = IkStatus::bad_configuration;
+      return best;
+    }
+    best.status = solve(pose, *options.configuration, *reference, best);
+    if (best && !fit_to_limits(best.q, *reference)) best.status = IkStatus::joint_limits;
+    return best;
+  }
+  // Closest to the reference over all configurations.
+  double best_distance = std::numeric_limits<double>::infinity();
+  best.status = IkStatus::out_of_reach;
+  for (std::size_t c = 0; c < names.size(); ++c) {
+    IkResult candidate;
+    if (solve(pose, Configuration{static_cast<std::uint8_t>(c)}, *reference, candidate) !=
+        IkStatus::ok) {
+      continue;
+    }
+    if (!fit_to_limits(candidate.q, *reference)) {
+      if (!best) best.status = IkStatus::joint_limits;
+      continue;
+    }
+    const double distance = squared_distance(candidate.q, *reference);
+    if (distance < best_distance) {
+      best_distance = distance;
+      best = candidate;
+      best.status = IkStatus::ok;
+    }
+  }
+  return best;
+}
+
+IkSolutions AnalyticKinematics::inverse_all(const math::Transform& pose,
+                                            const IkOptions& options) const noexcept {
+  IkSolutions all;
+  const auto reference = reference_pose(options);
+  if (!reference || !finite_pose(pose)) {
+    all.status = IkStatus::bad_input;
+    return all;
+  }
+  all.status = IkStatus::out_of_reach;
+  const auto names = configuration_names();
+  for (std::size_t c = 0; c < names.size() && all.count < kMaxIkSolutions; ++c) {
+    IkResult& slot = all.items[all.count];
+    if (solve(pose, Configuration{static_cast<std::uint8_t>(c)}, *reference, slot) !=
+        IkStatus::ok) {
+      continue;
+    }
+    if (!fit_to_limits(slot.q, *reference)) {
+      all.status = IkStatus::joint_limits;
+      continue;
+    }
+    slot.status = IkStatus::ok;
+    ++all.count;
+  }
+  if (all.count > 0) all.status = IkStatus::ok;
+  return all;
+}
+
+math::Transform Kinematics::chain_forward(const JointVector& q,
+                                          math::Transform* frames) const noexcept {
+  math::Transform T;
+  for (std::size_t i = 0; i < dof(); ++i) {
+    const Link& l = links_[i];
+    const double theta = l.theta + (l.prismatic ? 0.0 : q[i]);
+    const double d = l.d + (l.prismatic ? q[i] : 0.0);
+    const double ct = std::cos(theta), st = std::sin(theta);
+    // Thesis eq. 3.3, by columns n, o, a, p.
+    const math::Transform A{
+        {{ct, st, 0}, {-st * l.ca, ct * l.ca, l.sa}, {st * l.sa, -ct * l.sa, l.ca}},
+        {l.a * ct, l.a * st, d}};
+    T = T * A;
+    if (frames != nullptr) frames[i] = T;
+  }
+  return T;
+}
+
+Jacobian Kinematics::jacobian(const JointVector& q) const noexcept {
+  std::array<math::Transform, kMaxJoints> frames;
+  const math::Transform T6 = chain_forward(q, frames.data());
+  Jacobian J(6, static_cast<Eigen::Index>(dof()));
+  for (std::size_t i = 0; i < dof(); ++i) {
+    // Joint i+1 moves about / along z of frame i (the base frame for the first joint).
+    const math::Vec3 z = i == 0 ? math::Vec3{0, 0, 1} : frames[i - 1].R.a;
+    const math::Vec3 origin = i == 0 ? math::Vec3{} : frames[i - 1].p;
+    const math::Vec3 v = links_[i].prismatic ? z : math::cross(z, T6.p - origin);
+    const math::Vec3 w = links_[i].prismatic ? math::Vec3{} : z;
+    const auto col = static_cast<Eigen::Index>(i);
+    J.col(col) << v.x, v.y, v.z, w.x, w.y, w.z;
+  }
+  return J;
+}
+
+std::unique_ptr<Kinematics> make_kinematics(const RobotModel& model) {
+  switch (model.solver) {
+    case SolverKind::microbo:
+      return std::make_unique<MicroboKinematics>(model);
+    case SolverKind::puma:
+      return std::make_unique<PumaKinematics>(model);
+    case SolverKind::dh:
+      return std::make_unique<DhKinematics>(model);
+  }
+  return std::make_unique<DhKinematics>(model);
+}
+
+}  // namespace rccx::kin

@@ -1,0 +1,166 @@
+// The kinematics interface: one object per robot model, answering forward, inverse and
+// Jacobian questions. All calls are noexcept and allocation-free so that the trajectory
+// generator may call them every sample; failures come back as an IkStatus, never as an
+// exception (the planning level turns them into messages).
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <memory>
+#include <optional>
+#include <span>
+#include <string_view>
+
+#include "rccx/kinematics/joint_vector.hpp"
+#include "rccx/kinematics/robot_model.hpp"
+#include "rccx/math/transform.hpp"
+
+namespace rccx::kin {
+
+/// Why an inverse solution was not given.
+enum class IkStatus : std::uint8_t {
+  ok,
+  out_of_reach,       ///< no joint values put the wrist at that pose
+  joint_limits,       ///< solutions exist, but none (of the asked configuration) within limits
+  singular,           ///< the numeric solver met a singularity it could not leave
+  no_convergence,     ///< the numeric solver ran out of iterations
+  bad_configuration,  ///< the configuration asked for does not exist for this robot
+  bad_input,          ///< the pose has non-finite elements, or `near` has the wrong size
+};
+
+/// A one-line reason for people ("out of reach: ...").
+std::string_view describe(IkStatus status) noexcept;
+std::string_view to_string(IkStatus status) noexcept;
+
+/// Where a closed-form solution had to take a joint value from the `near` vector because the
+/// pose leaves it undetermined (thesis 3.6: "use the previous value of theta4").
+enum class Singularity : std::uint8_t { none, shoulder, elbow, wrist };
+std::string_view to_string(Singularity s) noexcept;
+
+/// A named arm configuration of a closed-form robot (an index into configuration_names()).
+struct Configuration {
+  std::uint8_t index = 0;
+  constexpr bool operator==(const Configuration&) const noexcept = default;
+};
+
+struct IkResult {
+  IkStatus status = IkStatus::bad_input;
+  JointVector q;  ///< rad / m; valid only when status is ok
+  Configuration configuration;
+  Singularity singularity = Singularity::none;
+  explicit operator bool() const noexcept { return status == IkStatus::ok; }
+};
+
+inline constexpr std::size_t kMaxIkSolutions = 8;
+
+/// Every configuration's solution within limits, at most kMaxIkSolutions.
+struct IkSolutions {
+  std::array<IkResult, kMaxIkSolutions> items{};
+  std::size_t count = 0;
+  IkStatus status = IkStatus::ok;  ///< why there are none, when count is 0
+  [[nodiscard]] std::span<const IkResult> solutions() const noexcept { return {items.data(), count}; }
+};
+
+struct IkOptions {
+  /// Solve for this configuration only. Without it, the solution closest to `near` is chosen.
+  std::optional<Configuration> configuration;
+  /// Joint values (rad / m) to stay close to: they pick among configurations and among the
+  /// 2 pi turns of revolute joints with more than a turn of range, fill joints left free by a
+  /// singularity, and seed the numeric solver. Defaults to the robot's ready pose.
+  std::optional<JointVector> near;
+};
+
+/// The geometric Jacobian: rows vx vy vz (m/s) and wx wy wz (rad/s) of frame T6, both expressed
+/// in the base frame, per unit joint velocity (rad/s or m/s). Fixed capacity: never allocates.
+using Jacobian = Eigen::Matrix<double, 6, Eigen::Dynamic, Eigen::ColMajor, 6, kMaxJoints>;
+
+/// Joint limits are checked with this much slack (rad or m), and values within it are clamped:
+/// a pose computed from a joint vector on its limit must solve back to that vector.
+inline constexpr double kLimitTolerance = 1e-9;
+
+class Kinematics {
+ public:
+  explicit Kinematics(RobotModel model);
+  virtual ~Kinematics() = default;
+  Kinematics(const Kinematics&) = delete;
+  Kinematics& operator=(const Kinematics&) = delete;
+
+  [[nodiscard]] const RobotModel& model() const noexcept { return model_; }
+  [[nodiscard]] std::size_t dof() const noexcept { return model_.dof(); }
+
+  /// T6, the pose of the last link frame in the base frame, for joint values q (rad / m).
+  /// q must have dof() values.
+  [[nodiscard]] virtual math::Transform forward(const JointVector& q) const noexcept = 0;
+
+  /// Joint values that put T6 at `pose`, within the joint limits.
+  [[nodiscard]] virtual IkResult inverse(const math::Transform& pose,
+                                         const IkOptions& options = {}) const noexcept = 0;
+
+  /// All distinct solutions within limits (one per configuration for closed forms; the numeric
+  /// solver gives the one it finds).
+  [[nodiscard]] virtual IkSolutions inverse_all(const math::Transform& pose,
+                                                const IkOptions& options = {}) const noexcept;
+
+  /// The geometric Jacobian at q, from the DH chain.
+  [[nodiscard]] virtual Jacobian jacobian(const JointVector& q) const noexcept;
+
+  /// Names of the arm configurations ("lun", "rdf" ... for the PUMA); empty when the solver
+  /// has none.
+  [[nodiscard]] virtual std::span<const std::string_view> configuration_names() const noexcept {
+    return {};
+  }
+  /// The configuration a joint vector is in.
+  [[nodiscard]] virtual Configuration configuration_of(const JointVector& q) const noexcept {
+    (void)q;
+    return {};
+  }
+  /// The configuration with that name, if any.
+  [[nodiscard]] std::optional<Configuration> find_configuration(std::string_view name) const noexcept;
+  [[nodiscard]] std::string_view configuration_name(Configuration c) const noexcept;
+
+ protected:
+  /// Moves each revolute joint of q by whole turns to the value within limits closest to
+  /// `toward`, and checks prismatic ones. False when some joint cannot be brought within limits.
+  bool fit_to_limits(JointVector& q, const JointVector& toward) const noexcept;
+  /// `near` when given and of the right size, else the ready pose; nullopt when it is given with
+  /// the wrong size.
+  std::optional<JointVector> reference_pose(const IkOptions& options) const noexcept;
+
+  /// T6 by multiplying the DH chain's A matrices (thesis eq. 3.11); frames[i], when given,
+  /// receives A1 ... A(i+1), the frame of link i+1.
+  math::Transform chain_forward(const JointVector& q,
+                                math::Transform* frames = nullptr) const noexcept;
+
+  /// Cached per-link constants of the DH chain.
+  struct Link {
+    double a, ca, sa, d, theta;
+    bool prismatic;
+  };
+  std::array<Link, kMaxJoints> links_{};
+
+ private:
+  RobotModel model_;
+};
+
+/// Closed-form solvers enumerate one raw solution per configuration; this base turns them into
+/// the inverse/inverse_all contract (limits, 2 pi turns, closest to near).
+class AnalyticKinematics : public Kinematics {
+ public:
+  using Kinematics::Kinematics;
+  [[nodiscard]] IkResult inverse(const math::Transform& pose,
+                                 const IkOptions& options = {}) const noexcept final;
+  [[nodiscard]] IkSolutions inverse_all(const math::Transform& pose,
+                                        const IkOptions& options = {}) const noexcept final;
+
+ protected:
+  /// Writes the raw solution (angles in (-pi, pi]) of configuration `which` into `out`; returns
+  /// ok or out_of_reach. `reference` fills joints a singularity leaves free.
+  virtual IkStatus solve(const math::Transform& pose, Configuration which,
+                         const JointVector& reference, IkResult& out) const noexcept = 0;
+};
+
+/// The solver the model asks for. Throws RobotFileError when the model's DH table does not have
+/// the structure its closed form needs.
+std::unique_ptr<Kinematics> make_kinematics(const RobotModel& model);
+
+}  // namespace rccx::kin

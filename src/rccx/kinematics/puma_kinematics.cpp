@@ -1,0 +1,177 @@
+#include "rccx/kinematics/puma_kinematics.hpp"
+
+#include <fmt/format.h>
+
+#include <array>
+#include <cmath>
+
+#include "rccx/math/units.hpp"
+
+namespace rccx::kin {
+
+namespace {
+
+// Index = 4 arm + 2 elbow + wrist, with arm 0 = left, elbow 0 = up, wrist 0 = no flip.
+constexpr std::array<std::string_view, 8> kConfigurationNames{"lun", "luf", "ldn", "ldf",
+                                                              "run", "ruf", "rdn", "rdf"};
+constexpr double kSingular = 1e-10;
+constexpr std::array<double, 6> kAlphaDeg{90, 0, -90, 90, -90, 0};
+
+}  // namespace
+
+PumaKinematics::PumaKinematics(RobotModel model) : AnalyticKinematics(std::move(model)) {
+  const RobotModel& m = this->model();
+  auto fail = [&](const std::string& what) {
+    throw RobotFileError(fmt::format(
+        "robot \"{}\" asks for the PUMA closed form, but {}; use \"solver\": \"dh\" for a "
+        "different chain",
+        m.name, what));
+  };
+  if (m.dof() != 6) fail(fmt::format("it has {} joints, not 6", m.dof()));
+  for (std::size_t i = 0; i < 6; ++i) {
+    const Joint& j = m.joints[i];
+    if (j.type != JointType::revolute) fail(fmt::format("joint {} is not revolute", i + 1));
+    if (std::abs(j.dh.alpha_rad - math::deg_to_rad(kAlphaDeg[i])) > 1e-12) {
+      fail(fmt::format("joint {} has alpha {} deg, not {}", i + 1,
+                       math::rad_to_deg(j.dh.alpha_rad), kAlphaDeg[i]));
+    }
+    if (std::abs(j.dh.theta_rad) > 1e-12) fail(fmt::format("joint {} has a theta offset", i + 1));
+    const bool a_allowed = i == 1 || i == 2;
+    if (!a_allowed && std::abs(j.dh.a_m) > 1e-12) fail(fmt::format("joint {} has a != 0", i + 1));
+    if (i == 4 && std::abs(j.dh.d_m) > 1e-12) fail("joint 5 has d != 0");
+  }
+  d1_ = m.joints[0].dh.d_m;
+  a2_ = m.joints[1].dh.a_m;
+  d3_ = m.joints[1].dh.d_m + m.joints[2].dh.d_m;  // z1 and z2 are parallel: the offsets add
+  a3_ = m.joints[2].dh.a_m;
+  d4_ = m.joints[3].dh.d_m;
+  d6_ = m.joints[5].dh.d_m;
+  L_ = std::hypot(a3_, d4_);
+  if (!(a2_ > 0.0) || !(L_ > 0.0)) fail("the upper arm (a2) and forearm (a3, d4) need length");
+  cphi_ = a3_ / L_;
+  sphi_ = d4_ / L_;
+}
+
+std::span<const std::string_view> PumaKinematics::configuration_names() const noexcept {
+  return kConfigurationNames;
+}
+
+Configuration PumaKinematics::configuration_of(const JointVector& q) const noexcept {
+  const double S2 = std::sin(q[1]), C2 = std::cos(q[1]);
+  const double S3 = std::sin(q[2]), C3 = std::cos(q[2]);
+  const double S23 = S2 * C3 + C2 * S3, C23 = C2 * C3 - S2 * S3;
+  const double reach = a2_ * C2 + a3_ * C23 - d4_ * S23;  // wrist centre along x1
+  const bool right = reach >= 0.0;
+  const double s = S3 * cphi_ + C3 * sphi_;  // sin(theta3 + phi)
+  const bool up = right ? s < 0.0 : s > 0.0;
+  const bool flip = std::sin(q[4]) < 0.0;
+  return Configuration{static_cast<std::uint8_t>((right ? 4 : 0) + (up ? 0 : 2) + (flip ? 1 : 0))};
+}
+
+math::Transform PumaKinematics::forward(const JointVector& q) const noexcept {
+  double S1, C1, S2, C2, S3, C3, S4, C4, S5, C5, S6, C6;
+  ::sincos(q[0], &S1, &C1);
+  ::sincos(q[1], &S2, &C2);
+  ::sincos(q[2], &S3, &C3);
+  ::sincos(q[3], &S4, &C4);
+  ::sincos(q[4], &S5, &C5);
+  ::sincos(q[5], &S6, &C6);
+  const double S23 = S2 * C3 + C2 * S3, C23 = C2 * C3 - S2 * S3;
+  // R03 by columns, and R36 = R4 R5 R6 by columns.
+  const math::Vec3 c0{C1 * C23, S1 * C23, S23};
+  const math::Vec3 c1{-S1, C1, 0.0};
+  const math::Vec3 c2{-C1 * S23, -S1 * S23, C23};
+  const double C4C5 = C4 * C5, S4C5 = S4 * C5;
+  const math::Vec3 n36{C4C5 * C6 - S4 * S6, S4C5 * C6 + C4 * S6, S5 * C6};
+  const math::Vec3 o36{-C4C5 * S6 - S4 * C6, -S4C5 * S6 + C4 * C6, -S5 * S6};
+  const math::Vec3 a36{-C4 * S5, -S4 * S5, C5};
+  auto times_r03 = [&](const math::Vec3& v) {
+    return math::Vec3{c0.x * v.x + c1.x * v.y + c2.x * v.z, c0.y * v.x + c1.y * v.y + c2.y * v.z,
+                      c0.z * v.x + c2.z * v.z};
+  };
+  const math::Vec3 a = times_r03(a36);
+  // Wrist centre: in frame 1, (reach, height, d3); then into the base frame.
+  const double reach = a2_ * C2 + a3_ * C23 - d4_ * S23;
+  const double height = a2_ * S2 + a3_ * S23 + d4_ * C23;
+  const math::Vec3 wrist{C1 * reach + S1 * d3_, S1 * reach - C1 * d3_, height + d1_};
+  return {{times_r03(n36), times_r03(o36), a}, wrist + a * d6_};
+}
+
+IkStatus PumaKinematics::solve(const math::Transform& pose, Configuration which,
+                               const JointVector& reference, IkResult& out) const noexcept {
+  const bool right = (which.index & 4) != 0;
+  const bool down = (which.index & 2) != 0;
+  const bool flip = (which.index & 1) != 0;
+  out.q = JointVector(6);
+  out.configuration = which;
+  out.singularity = Singularity::none;
+
+  const math::Vec3 w = pose.p - pose.R.a * d6_;  // wrist centre
+  const double z = w.z - d1_;
+
+  // Joint 1: the wrist centre sits at lateral offset d3 from the arm's plane, at reach rho.
+  const double r2 = w.x * w.x + w.y * w.y;
+  const double rho2 = r2 - d3_ * d3_;
+  if (rho2 < -1e-12) return IkStatus::out_of_reach;  // inside the cylinder of radius |d3|
+  const double arm = right ? 1.0 : -1.0;
+  const double rho = arm * std::sqrt(std::max(rho2, 0.0));
+  double S1, C1;
+  if (r2 > kSingular * kSingular) {
+    C1 = (rho * w.x - d3_ * w.y) / r2;
+    S1 = (d3_ * w.x + rho * w.y) / r2;
+    out.q[0] = std::atan2(S1, C1);
+  } else {  // wrist centre on joint 1's axis (only when d3 = 0): keep the reference theta1
+    out.q[0] = reference[0];
+    ::sincos(out.q[0], &S1, &C1);
+    out.singularity = Singularity::shoulder;
+  }
+
+  // Joints 2 and 3: a planar two-link problem in the arm's plane, wrist at (rho, z).
+  const double D = rho * rho + z * z;
+  const double c = (D - a2_ * a2_ - L_ * L_) / (2.0 * a2_ * L_);  // cos(theta3 + phi)
+  if (c > 1.0 + 1e-12 || c < -1.0 - 1e-12) return IkStatus::out_of_reach;
+  const double cc = std::clamp(c, -1.0, 1.0);
+  const double elbow = (down ? 1.0 : -1.0) * arm;  // sign of sin(theta3 + phi)
+  const double s = elbow * std::sqrt(1.0 - cc * cc);
+  const double C3 = cc * cphi_ + s * sphi_;
+  const double S3 = s * cphi_ - cc * sphi_;
+  out.q[2] = std::atan2(S3, C3);
+  const double X = a2_ + L_ * cc, Y = L_ * s;  // wrist in frame 2
+  double S2, C2;
+  if (D > kSingular * kSingular) {
+    C2 = (rho * X + z * Y) / D;
+    S2 = (z * X - rho * Y) / D;
+    out.q[1] = std::atan2(S2, C2);
+  } else {  // wrist centre on the shoulder (only when a2 = forearm length)
+    out.q[1] = reference[1];
+    ::sincos(out.q[1], &S2, &C2);
+    out.singularity = Singularity::elbow;
+  }
+
+  // Joints 4-6 from R36 = R03^T R: a36 = (-C4 S5, -S4 S5, C5), n36_z = S5 C6, o36_z = -S5 S6.
+  const double S23 = S2 * C3 + C2 * S3, C23 = C2 * C3 - S2 * S3;
+  const math::Vec3 c0{C1 * C23, S1 * C23, S23};
+  const math::Vec3 c1{-S1, C1, 0.0};
+  const math::Vec3 c2{-C1 * S23, -S1 * S23, C23};
+  const math::Vec3& n = pose.R.n;
+  const math::Vec3& o = pose.R.o;
+  const math::Vec3& a = pose.R.a;
+  const double r02 = math::dot(c0, a), r12 = math::dot(c1, a), r22 = math::dot(c2, a);
+  const double r20 = math::dot(c2, n), r21 = math::dot(c2, o);
+  const double wrist = flip ? -1.0 : 1.0;  // sign of S5
+  const double S5 = wrist * std::hypot(r02, r12);
+  out.q[4] = std::atan2(S5, r22);
+  if (S5 * wrist > kSingular) {
+    out.q[3] = std::atan2(-wrist * r12, -wrist * r02);
+    out.q[5] = std::atan2(-wrist * r21, wrist * r20);
+  } else {  // theta5 = 0 or pi: joints 4 and 6 aligned, keep the reference theta4
+    out.q[3] = reference[3];
+    const double r00 = math::dot(c0, n), r10 = math::dot(c1, n);
+    out.q[5] = r22 > 0.0 ? std::atan2(r10, r00) - out.q[3] : out.q[3] + std::atan2(r10, -r00);
+    out.q[5] = std::remainder(out.q[5], 2.0 * math::kPi);
+    out.singularity = Singularity::wrist;
+  }
+  return IkStatus::ok;
+}
+
+}  // namespace rccx::kin

@@ -1,0 +1,221 @@
+#include "rccx/kinematics/robot_model.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
+
+#include "rccx/kinematics/embedded_robots.hpp"
+#include "rccx/math/units.hpp"
+
+namespace rccx::kin {
+
+using nlohmann::json;
+
+JointVector RobotModel::ready() const noexcept {
+  JointVector q(dof());
+  for (std::size_t i = 0; i < dof(); ++i) q[i] = joints[i].ready;
+  return q;
+}
+
+JointVector RobotModel::lower() const noexcept {
+  JointVector q(dof());
+  for (std::size_t i = 0; i < dof(); ++i) q[i] = joints[i].lower;
+  return q;
+}
+
+JointVector RobotModel::upper() const noexcept {
+  JointVector q(dof());
+  for (std::size_t i = 0; i < dof(); ++i) q[i] = joints[i].upper;
+  return q;
+}
+
+int RobotModel::first_joint_outside_limits(const JointVector& q, double tolerance) const noexcept {
+  if (q.size() != dof()) return 0;
+  for (std::size_t i = 0; i < dof(); ++i) {
+    // Written so that NaN counts as outside.
+    if (!(q[i] >= joints[i].lower - tolerance && q[i] <= joints[i].upper + tolerance)) {
+      return static_cast<int>(i);
+    }
+  }
+  return -1;
+}
+
+bool RobotModel::within_limits(const JointVector& q, double tolerance) const noexcept {
+  return first_joint_outside_limits(q, tolerance) < 0;
+}
+
+std::string_view to_string(JointType type) noexcept {
+  return type == JointType::revolute ? "revolute" : "prismatic";
+}
+
+std::string_view to_string(SolverKind kind) noexcept {
+  switch (kind) {
+    case SolverKind::microbo:
+      return "microbo";
+    case SolverKind::puma:
+      return "puma";
+    case SolverKind::dh:
+      return "dh";
+  }
+  return "?";
+}
+
+namespace {
+
+// Reads a JSON object key by key so that every error names where it is, and so that an unknown
+// key (a typo such as "upper_mm") is refused instead of silently ignored.
+class Reader {
+ public:
+  Reader(const json& object, std::string where) : object_(object), where_(std::move(where)) {
+    if (!object_.is_object()) fail("expected an object");
+  }
+
+  [[noreturn]] void fail(const std::string& what) const {
+    throw RobotFileError(fmt::format("{}: {}", where_, what));
+  }
+
+  bool has(const char* key) {
+    used_.insert(key);
+    return object_.contains(key);
+  }
+
+  const json& get(const char* key) {
+    if (!has(key)) fail(fmt::format("missing \"{}\"", key));
+    return object_.at(key);
+  }
+
+  std::string string(const char* key) {
+    const json& v = get(key);
+    if (!v.is_string()) fail(fmt::format("\"{}\" must be a string", key));
+    return v.get<std::string>();
+  }
+
+  double number(const char* key) {
+    const json& v = get(key);
+    if (!v.is_number()) fail(fmt::format("\"{}\" must be a number", key));
+    const double d = v.get<double>();
+    if (!std::isfinite(d)) fail(fmt::format("\"{}\" must be finite", key));
+    return d;
+  }
+
+  double number_or(const char* key, double fallback) { return has(key) ? number(key) : fallback; }
+
+  void no_unknown_keys() const {
+    for (const auto& item : object_.items()) {
+      if (!used_.contains(item.key())) fail(fmt::format("unknown key \"{}\"", item.key()));
+    }
+  }
+
+  const std::string& where() const { return where_; }
+
+ private:
+  const json& object_;
+  std::string where_;
+  std::set<std::string> used_;
+};
+
+Joint parse_joint(const json& j, const std::string& where) {
+  Reader r(j, where);
+  Joint joint;
+  joint.name = r.string("name");
+  const std::string type = r.string("type");
+  if (type == "revolute") {
+    joint.type = JointType::revolute;
+  } else if (type == "prismatic") {
+    joint.type = JointType::prismatic;
+  } else {
+    r.fail(fmt::format("\"type\" is \"{}\"; use \"revolute\" or \"prismatic\"", type));
+  }
+  joint.dh.a_m = r.number("a_m");
+  joint.dh.alpha_rad = math::deg_to_rad(r.number("alpha_deg"));
+  joint.dh.d_m = r.number_or("d_m", 0.0);
+  joint.dh.theta_rad = math::deg_to_rad(r.number_or("theta_deg", 0.0));
+  if (joint.type == JointType::revolute) {
+    joint.lower = math::deg_to_rad(r.number("lower_deg"));
+    joint.upper = math::deg_to_rad(r.number("upper_deg"));
+    joint.resolution_per_count = math::deg_to_rad(r.number("resolution_deg_per_count"));
+    joint.ready = math::deg_to_rad(r.number("ready_deg"));
+  } else {
+    joint.lower = r.number("lower_m");
+    joint.upper = r.number("upper_m");
+    joint.resolution_per_count = r.number("resolution_mm_per_count") * 1e-3;
+    joint.ready = r.number("ready_m");
+  }
+  r.has("note");  // free text, for people
+  r.no_unknown_keys();
+  if (!(joint.lower < joint.upper)) r.fail("the lower limit must be below the upper limit");
+  if (!(joint.resolution_per_count > 0)) r.fail("the encoder resolution must be positive");
+  if (joint.ready < joint.lower || joint.ready > joint.upper) {
+    r.fail("the ready value lies outside the joint limits");
+  }
+  return joint;
+}
+
+}  // namespace
+
+RobotModel parse_robot(std::string_view json_text, std::string_view origin) {
+  json doc;
+  try {
+    doc = json::parse(json_text, nullptr, /*allow_exceptions=*/true, /*ignore_comments=*/true);
+  } catch (const json::parse_error& e) {
+    throw RobotFileError(fmt::format("{}: not valid JSON: {}", origin, e.what()));
+  }
+  Reader r(doc, std::string(origin));
+  RobotModel model;
+  model.name = r.string("name");
+  model.title = r.string("title");
+  model.source = r.string("source");
+  const std::string solver = r.string("solver");
+  if (solver == "microbo") {
+    model.solver = SolverKind::microbo;
+  } else if (solver == "puma") {
+    model.solver = SolverKind::puma;
+  } else if (solver == "dh") {
+    model.solver = SolverKind::dh;
+  } else {
+    r.fail(fmt::format("\"solver\" is \"{}\"; use \"microbo\", \"puma\" or \"dh\"", solver));
+  }
+  const json& joints = r.get("joints");
+  if (!joints.is_array() || joints.empty() || joints.size() > kMaxJoints) {
+    r.fail(fmt::format("\"joints\" must be an array of 1 to {} joints", kMaxJoints));
+  }
+  for (std::size_t i = 0; i < joints.size(); ++i) {
+    model.joints.push_back(parse_joint(joints[i], fmt::format("{}: joint {}", origin, i + 1)));
+  }
+  r.has("notes");
+  r.no_unknown_keys();
+  return model;
+}
+
+RobotModel load_robot_file(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  if (!in) throw RobotFileError(fmt::format("{}: cannot open the robot file", path.string()));
+  std::ostringstream text;
+  text << in.rdbuf();
+  return parse_robot(text.str(), path.string());
+}
+
+std::vector<std::string> builtin_robot_names() {
+  std::vector<std::string> names;
+  for (const auto& robot : detail::embedded_robots()) {
+    std::string_view n = robot.file_name;
+    names.emplace_back(n.substr(0, n.rfind('.')));
+  }
+  return names;
+}
+
+RobotModel builtin_robot(std::string_view name) {
+  for (const auto& robot : detail::embedded_robots()) {
+    if (robot.file_name.substr(0, robot.file_name.rfind('.')) == name) {
+      return parse_robot(robot.text, fmt::format("robots/{}", robot.file_name));
+    }
+  }
+  throw RobotFileError(fmt::format("no robot named \"{}\"; known robots: {}", name,
+                                   fmt::join(builtin_robot_names(), ", ")));
+}
+
+}  // namespace rccx::kin

@@ -1,0 +1,80 @@
+// The constant description of a robot arm: its joints in standard Denavit-Hartenberg form
+// (thesis section 3.4), their limits and encoder resolution, and which solver serves it. It is
+// read once from a data file under robots/ and never changes while a program runs; everything
+// computed from it per call lives in the solvers (the Model / Data split of Pinocchio).
+#pragma once
+
+#include <filesystem>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "rccx/kinematics/joint_vector.hpp"
+
+namespace rccx::kin {
+
+enum class JointType : std::uint8_t { revolute, prismatic };
+
+/// Standard DH parameters of one link (thesis eq. 3.3/3.4). The joint variable q is added to
+/// theta_rad for a revolute joint and to d_m for a prismatic one.
+struct DhParameters {
+  double a_m = 0.0;
+  double alpha_rad = 0.0;
+  double d_m = 0.0;
+  double theta_rad = 0.0;
+};
+
+struct Joint {
+  std::string name;
+  JointType type = JointType::revolute;
+  DhParameters dh;
+  double lower = 0.0;  ///< lower limit, rad or m
+  double upper = 0.0;  ///< upper limit, rad or m
+  double resolution_per_count = 0.0;  ///< encoder resolution, rad or m per count
+  double ready = 0.0;                 ///< value in the robot's ready (nominal) pose, rad or m
+};
+
+/// Which solver a model asks for: the thesis's closed form for the Microbo, the PUMA closed
+/// form, or the numeric solver that serves any DH chain.
+enum class SolverKind : std::uint8_t { microbo, puma, dh };
+
+struct RobotModel {
+  std::string name;    ///< short id used on the command line ("microbo", "puma560")
+  std::string title;   ///< human name
+  std::string source;  ///< where the numbers come from
+  SolverKind solver = SolverKind::dh;
+  std::vector<Joint> joints;
+
+  [[nodiscard]] std::size_t dof() const noexcept { return joints.size(); }
+  [[nodiscard]] JointVector ready() const noexcept;
+  [[nodiscard]] JointVector lower() const noexcept;
+  [[nodiscard]] JointVector upper() const noexcept;
+  /// True when every joint is within its limits, widened by tolerance (rad or m).
+  [[nodiscard]] bool within_limits(const JointVector& q, double tolerance = 0.0) const noexcept;
+  /// The index of the first joint outside its limits, or -1.
+  [[nodiscard]] int first_joint_outside_limits(const JointVector& q,
+                                               double tolerance = 0.0) const noexcept;
+};
+
+/// A robot file that cannot be used; the message names the file, the joint and the key.
+class RobotFileError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// Parses a robot description (JSON with // comments allowed; see robots/README.md).
+/// `origin` names the text in error messages.
+RobotModel parse_robot(std::string_view json_text, std::string_view origin);
+/// Reads and parses a robot file.
+RobotModel load_robot_file(const std::filesystem::path& path);
+
+/// The robots shipped in robots/, compiled into the library.
+std::vector<std::string> builtin_robot_names();
+/// A shipped robot by name; throws RobotFileError listing the known names when there is none.
+RobotModel builtin_robot(std::string_view name);
+
+std::string_view to_string(JointType type) noexcept;
+std::string_view to_string(SolverKind kind) noexcept;
+
+}  // namespace rccx::kin

@@ -1,0 +1,359 @@
+#include "kin_command.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <iostream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "rccx/kinematics/kinematics.hpp"
+#include "rccx/math/units.hpp"
+
+namespace rccx::tools {
+
+namespace {
+
+using json = nlohmann::ordered_json;
+
+/// A bad argument found after parsing: its message goes to stderr and rccx exits with 2.
+struct BadArgument {
+  std::string message;
+};
+
+struct RobotChoice {
+  std::string name = "puma560";
+  std::string file;
+
+  [[nodiscard]] std::unique_ptr<kin::Kinematics> load() const {
+    try {
+      return kin::make_kinematics(file.empty() ? kin::builtin_robot(name)
+                                               : kin::load_robot_file(file));
+    } catch (const kin::RobotFileError& e) {
+      throw BadArgument{e.what()};
+    }
+  }
+};
+
+void add_robot_options(CLI::App& cmd, RobotChoice& robot) {
+  cmd.add_option("--robot", robot.name,
+                 "Shipped robot to use (see `rccx kin robots`): microbo, puma560, puma260")
+      ->capture_default_str();
+  cmd.add_option("--robot-file", robot.file,
+                 "Robot description file (JSON, see robots/README.md); overrides --robot")
+      ->check(CLI::ExistingFile);
+}
+
+std::string unit_of(const kin::Joint& j) { return j.type == kin::JointType::revolute ? "rad" : "m"; }
+
+/// Joint values given by the user, in rad/m, or in deg/m when `degrees` is set.
+kin::JointVector joints_from(const std::vector<double>& values, const kin::Kinematics& k,
+                             bool degrees, const char* what) {
+  if (values.size() != k.dof()) {
+    throw BadArgument{fmt::format("{}: robot {} has {} joints, got {} values", what,
+                                  k.model().name, k.dof(), values.size())};
+  }
+  kin::JointVector q(k.dof());
+  for (std::size_t i = 0; i < k.dof(); ++i) {
+    if (!std::isfinite(values[i])) throw BadArgument{fmt::format("{}: value {} is not finite", what, i + 1)};
+    const bool revolute = k.model().joints[i].type == kin::JointType::revolute;
+    q[i] = degrees && revolute ? math::deg_to_rad(values[i]) : values[i];
+  }
+  return q;
+}
+
+void warn_outside_limits(const kin::Kinematics& k, const kin::JointVector& q) {
+  for (std::size_t i = 0; i < k.dof(); ++i) {
+    const kin::Joint& j = k.model().joints[i];
+    if (q[i] < j.lower || q[i] > j.upper) {
+      fmt::print(stderr, "warning: joint {} ({}) = {} {} is outside its limits [{}, {}]\n", i + 1,
+                 j.name, q[i], unit_of(j), j.lower, j.upper);
+    }
+  }
+}
+
+json to_json(const kin::JointVector& q) { return json(std::vector<double>(q.begin(), q.end())); }
+
+std::string format_joints(const kin::Kinematics& k, const kin::JointVector& q) {
+  std::string out;
+  for (std::size_t i = 0; i < q.size(); ++i) {
+    const kin::Joint& j = k.model().joints[i];
+    const bool revolute = j.type == kin::JointType::revolute;
+    out += fmt::format("  {:>7} = {:>12.9f} {:<3}  ({:.4f} {})\n", j.name, q[i], unit_of(j),
+                       revolute ? math::rad_to_deg(q[i]) : q[i] * 1e3, revolute ? "deg" : "mm");
+  }
+  return out;
+}
+
+std::string format_transform(const math::Transform& T) {
+  std::string out = "          n            o            a            p (m)\n";
+  for (int r = 0; r < 4; ++r) {
+    out += fmt::format("  {:>12.9f} {:>12.9f} {:>12.9f} {:>12.9f}\n", T(r, 0), T(r, 1), T(r, 2),
+                       T(r, 3));
+  }
+  return out;
+}
+
+// ---- rccx kin fk ----
+
+struct FkArgs {
+  RobotChoice robot;
+  std::vector<double> q;
+  bool degrees = false;
+  bool json = false;
+};
+
+int run_fk(const FkArgs& args) {
+  const auto k = args.robot.load();
+  const kin::JointVector q = joints_from(args.q, *k, args.degrees, "joint values");
+  warn_outside_limits(*k, q);
+  const math::Transform T = k->forward(q);
+  if (args.json) {
+    json rows = json::array();
+    for (int r = 0; r < 4; ++r) rows.push_back({T(r, 0), T(r, 1), T(r, 2), T(r, 3)});
+    fmt::print("{}\n", json{{"robot", k->model().name}, {"q", to_json(q)}, {"T", rows}}.dump());
+    return kOk;
+  }
+  fmt::print("{} ({})\njoints:\n{}", k->model().name, k->model().title, format_joints(*k, q));
+  if (!k->configuration_names().empty()) {
+    fmt::print("configuration: {}\n", k->configuration_name(k->configuration_of(q)));
+  }
+  fmt::print("T6:\n{}", format_transform(T));
+  return kOk;
+}
+
+// ---- rccx kin ik ----
+
+struct IkArgs {
+  RobotChoice robot;
+  std::vector<double> T;
+  std::string config;
+  std::vector<double> near;
+  bool degrees = false;
+  bool all = false;
+  bool json = false;
+};
+
+math::Transform pose_from(const std::vector<double>& values) {
+  if (values.size() != 12) {
+    throw BadArgument{fmt::format("--T takes 12 numbers (r11,r12,r13,px,...,r33,pz), got {}",
+                                  values.size())};
+  }
+  std::array<double, 12> m{};
+  for (std::size_t i = 0; i < 12; ++i) {
+    if (!std::isfinite(values[i])) throw BadArgument{"--T: every number must be finite"};
+    m[i] = values[i];
+  }
+  const math::Transform T = math::Transform::from_rows(m);
+  // RᵀR must be the identity: a pose with a sheared or scaled rotation has no joint solution.
+  const math::Rot3 RtR = T.R.transposed() * T.R;
+  double error = 0.0;
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) error = std::max(error, std::abs(RtR(r, c) - (r == c ? 1.0 : 0.0)));
+  }
+  const double det = math::dot(math::cross(T.R.n, T.R.o), T.R.a);
+  if (error > 1e-6 || det < 0) {
+    throw BadArgument{fmt::format(
+        "--T: the rotation part is not a rotation matrix (|RtR - I| = {:.2g}, det = {:.6g}); give "
+        "the nine r numbers of an orthonormal, right-handed frame",
+        error, det)};
+  }
+  return T;
+}
+
+int run_ik(const IkArgs& args) {
+  const auto k = args.robot.load();
+  const math::Transform pose = pose_from(args.T);
+  kin::IkOptions options;
+  if (!args.config.empty()) {
+    const auto names = k->configuration_names();
+    if (names.empty()) {
+      throw BadArgument{fmt::format(
+          "--config: robot {} is solved numerically and has no named configurations; use --near",
+          k->model().name)};
+    }
+    options.configuration = k->find_configuration(args.config);
+    if (!options.configuration) {
+      std::string list;
+      for (auto n : names) list += std::string(list.empty() ? "" : ", ") + std::string(n);
+      throw BadArgument{fmt::format("--config: robot {} has no configuration \"{}\"; use one of {}",
+                                    k->model().name, args.config, list)};
+    }
+  }
+  if (!args.near.empty()) options.near = joints_from(args.near, *k, args.degrees, "--near");
+
+  const bool named = !k->configuration_names().empty();
+  auto config_name = [&](const kin::IkResult& r) {
+    return named ? std::string(k->configuration_name(r.configuration)) : std::string("dh");
+  };
+  auto report_singularity = [&](const kin::IkResult& r) {
+    if (r.singularity != kin::Singularity::none) {
+      fmt::print(stderr, "note: {} singularity; a joint left free by it was taken from {}\n",
+                 kin::to_string(r.singularity), options.near ? "--near" : "the ready pose");
+    }
+  };
+
+  if (args.all) {
+    kin::IkSolutions all = k->inverse_all(pose, options);
+    if (options.configuration && all.count > 0) {  // --all with --config: that one only
+      std::size_t kept = 0;
+      for (std::size_t i = 0; i < all.count; ++i) {
+        if (all.items[i].configuration == *options.configuration) all.items[kept++] = all.items[i];
+      }
+      if (kept == 0) all.status = kin::IkStatus::joint_limits;
+      all.count = kept;
+    }
+    if (all.count == 0) {
+      fmt::print(stderr, "{}: {}\n", k->model().name, kin::describe(all.status));
+      return kUnreachable;
+    }
+    if (args.json) {
+      json list = json::array();
+      for (const auto& r : all.solutions()) {
+        list.push_back({{"config", config_name(r)}, {"q", to_json(r.q)}});
+      }
+      fmt::print("{}\n", json{{"robot", k->model().name}, {"solutions", list}}.dump());
+    } else {
+      fmt::print("{} ({}): {} solution(s) within limits\n", k->model().name, k->model().title,
+                 all.count);
+      for (const auto& r : all.solutions()) {
+        fmt::print("configuration {}:\n{}", config_name(r), format_joints(*k, r.q));
+      }
+    }
+    for (const auto& r : all.solutions()) report_singularity(r);
+    return kOk;
+  }
+
+  const kin::IkResult r = k->inverse(pose, options);
+  if (!r) {
+    fmt::print(stderr, "{}: {}\n", k->model().name, kin::describe(r.status));
+    return kUnreachable;
+  }
+  report_singularity(r);
+  if (args.json) {
+    fmt::print("{}\n",
+               json{{"robot", k->model().name}, {"q", to_json(r.q)}, {"config", config_name(r)}}
+                   .dump());
+  } else {
+    fmt::print("{} ({}), configuration {}:\n{}", k->model().name, k->model().title,
+               config_name(r), format_joints(*k, r.q));
+  }
+  return kOk;
+}
+
+// ---- rccx kin robots ----
+
+int run_robots(bool as_json) {
+  json list = json::array();
+  for (const std::string& name : kin::builtin_robot_names()) {
+    const kin::RobotModel model = kin::builtin_robot(name);
+    const auto k = kin::make_kinematics(model);
+    if (!as_json) {
+      fmt::print("{} - {} ({} solver, {} joints)\n  source: {}\n", model.name, model.title,
+                 kin::to_string(model.solver), model.dof(), model.source);
+      if (!k->configuration_names().empty()) {
+        std::string names;
+        for (auto n : k->configuration_names()) names += " " + std::string(n);
+        fmt::print("  configurations:{}\n", names);
+      }
+    }
+    json joints = json::array();
+    for (const kin::Joint& j : model.joints) {
+      const bool revolute = j.type == kin::JointType::revolute;
+      if (as_json) {
+        joints.push_back({{"name", j.name},
+                          {"type", kin::to_string(j.type)},
+                          {"lower", j.lower},
+                          {"upper", j.upper},
+                          {"unit", unit_of(j)},
+                          {"resolution_per_count", j.resolution_per_count}});
+      } else if (revolute) {
+        fmt::print("  {:>7}  revolute   {:>9.3f} .. {:>8.3f} deg   {:.4f} deg/count\n", j.name,
+                   math::rad_to_deg(j.lower), math::rad_to_deg(j.upper),
+                   math::rad_to_deg(j.resolution_per_count));
+      } else {
+        fmt::print("  {:>7}  prismatic  {:>9.4f} .. {:>8.4f} m     {:.4f} mm/count\n", j.name,
+                   j.lower, j.upper, j.resolution_per_count * 1e3);
+      }
+    }
+    if (as_json) {
+      list.push_back({{"name", model.name},
+                      {"title", model.title},
+                      {"solver", kin::to_string(model.solver)},
+                      {"joints", joints}});
+    }
+  }
+  if (as_json) fmt::print("{}\n", list.dump());
+  return kOk;
+}
+
+template <typename F>
+void guarded(int& exit_code, F&& run) {
+  try {
+    exit_code = run();
+  } catch (const BadArgument& e) {
+    fmt::print(stderr, "error: {}\n", e.message);
+    exit_code = kBadArguments;
+  }
+}
+
+}  // namespace
+
+void add_kin_command(CLI::App& app, int& exit_code) {
+  CLI::App* kin = app.add_subcommand(
+      "kin",
+      "Forward and inverse kinematics. Joint values are those of each robot's model: rad for "
+      "revolute joints, m for prismatic ones; poses are T6 (wrist frame) in the base frame, m.");
+  kin->require_subcommand(1);
+
+  auto fk = std::make_shared<FkArgs>();
+  CLI::App* fk_cmd = kin->add_subcommand("fk", "Forward kinematics: T6 for given joint values");
+  add_robot_options(*fk_cmd, fk->robot);
+  fk_cmd->add_option("q", fk->q, "Joint values q1 ... qN (rad or m; with --deg, deg or m)")
+      ->required()
+      ->allow_extra_args();
+  fk_cmd->add_flag("--deg", fk->degrees, "Revolute joint values are in degrees (prismatic stay m)");
+  fk_cmd->add_flag("--json", fk->json,
+                   "Print {\"robot\":..,\"q\":[rad|m],\"T\":[[4 numbers] x 4 rows]}");
+  fk_cmd->callback([fk, &exit_code] { guarded(exit_code, [&] { return run_fk(*fk); }); });
+
+  auto ik = std::make_shared<IkArgs>();
+  CLI::App* ik_cmd = kin->add_subcommand(
+      "ik", "Inverse kinematics: joint values within limits for a T6 pose. Exit code 3 when the "
+            "pose cannot be reached (the reason goes to stderr), 2 for bad arguments");
+  add_robot_options(*ik_cmd, ik->robot);
+  ik_cmd
+      ->add_option("--T", ik->T,
+                   "Pose as 12 comma-separated numbers, row by row: r11,r12,r13,px,r21,r22,r23,py,"
+                   "r31,r32,r33,pz (r: rotation matrix, p: position in m)")
+      ->delimiter(',')
+      ->required();
+  CLI::Option* config_opt = ik_cmd->add_option(
+      "--config", ik->config,
+      "Configuration to solve for: PUMA l|r (arm) u|d (elbow) n|f (wrist), e.g. lun; Microbo n|f "
+      "(wrist)");
+  CLI::Option* near_opt = ik_cmd->add_option(
+      "--near", ik->near,
+      "Comma-separated joint values (rad or m; with --deg, deg or m) to stay closest to; "
+      "default: the robot's ready pose")
+      ->delimiter(',');
+  config_opt->excludes(near_opt);
+  ik_cmd->add_flag("--all", ik->all, "Print every configuration's solution within limits");
+  ik_cmd->add_flag("--deg", ik->degrees, "--near is in degrees for revolute joints");
+  ik_cmd->add_flag("--json", ik->json,
+                   "Print {\"robot\":..,\"q\":[..],\"config\":..}, or with --all "
+                   "{\"robot\":..,\"solutions\":[{\"config\":..,\"q\":[..]},...]}");
+  ik_cmd->callback([ik, &exit_code] { guarded(exit_code, [&] { return run_ik(*ik); }); });
+
+  auto robots_json = std::make_shared<bool>(false);
+  CLI::App* robots_cmd = kin->add_subcommand(
+      "robots", "List the shipped robots with their joint types, limits and encoder resolution");
+  robots_cmd->add_flag("--json", *robots_json, "Print a JSON array (limits in rad or m)");
+  robots_cmd->callback(
+      [robots_json, &exit_code] { guarded(exit_code, [&] { return run_robots(*robots_json); }); });
+}
+
+}  // namespace rccx::tools
