@@ -1,0 +1,150 @@
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "rccx/kinematics/kinematics.hpp"
+#include "rccx/math/units.hpp"
+
+namespace {
+
+using namespace rccx;
+using namespace rccx::math::literals;
+
+TEST(BuiltinRobots, AreShippedAndConsistent) {
+  const auto names = kin::builtin_robot_names();
+  for (const char* expected : {"microbo", "puma560", "puma260"}) {
+    EXPECT_NE(std::find(names.begin(), names.end(), expected), names.end()) << expected;
+  }
+  for (const auto& name : names) {
+    const kin::RobotModel model = kin::builtin_robot(name);
+    EXPECT_EQ(model.name, name);
+    EXPECT_EQ(model.dof(), 6u);
+    EXPECT_FALSE(model.source.empty());
+    EXPECT_TRUE(model.within_limits(model.ready())) << name;
+    EXPECT_NO_THROW((void)kin::make_kinematics(model)) << name;
+  }
+  EXPECT_THROW((void)kin::builtin_robot("puma600"), kin::RobotFileError);
+}
+
+TEST(BuiltinRobots, Puma560IsCorkesStandardDhModel) {
+  const kin::RobotModel m = kin::builtin_robot("puma560");
+  EXPECT_EQ(m.joints[1].dh.a_m, 0.4318);
+  EXPECT_EQ(m.joints[2].dh.a_m, 0.0203);
+  EXPECT_EQ(m.joints[2].dh.d_m, 0.15005);
+  EXPECT_EQ(m.joints[3].dh.d_m, 0.4318);
+}
+
+// Thesis 2.5 and the reading guide: 16-bit encoders are too small for joints 1 and 3, 18 bits
+// are enough; the others fit in 16 bits.
+TEST(BuiltinRobots, MicroboRangesFitItsEncoders) {
+  const kin::RobotModel m = kin::builtin_robot("microbo");
+  const double thesis_resolution[6] = {0.0031_deg, 0.0020_mm, 0.0013_mm,
+                                       0.0041_deg, 0.0056_deg, 0.0182_deg};
+  for (std::size_t i = 0; i < 6; ++i) {
+    const kin::Joint& j = m.joints[i];
+    EXPECT_NEAR(j.resolution_per_count, thesis_resolution[i], 1e-15);
+    const double counts = (j.upper - j.lower) / j.resolution_per_count;
+    EXPECT_LE(counts, 262143.0) << j.name;
+    if (i == 0 || i == 2) {
+      EXPECT_GT(counts, 65535.0) << j.name;
+    } else {
+      EXPECT_LE(counts, 65535.0) << j.name;
+    }
+  }
+  // Joint 5 covers the thesis's approximate range -pi/2 .. -3 pi/2.
+  EXPECT_LE(m.joints[4].lower, -270.0_deg);
+  EXPECT_GE(m.joints[4].upper, -90.0_deg);
+}
+
+TEST(BuiltinRobots, MicroboLimitsHoldTheWasherCornersWithMargin) {
+  const kin::RobotModel m = kin::builtin_robot("microbo");
+  // theta1, d2, d3, theta4, theta5, theta6 at the washer's extremes (reading guide).
+  const double corners[][6] = {
+      {24.8_deg, 250_mm, 325_mm, 90_deg, -90_deg, -155.2_deg},
+      {-24.8_deg, 300_mm, 358_mm, 90_deg, -90_deg, 155.2_deg},
+  };
+  for (const auto& c : corners) {
+    for (std::size_t i = 0; i < 6; ++i) {
+      const bool revolute = m.joints[i].type == kin::JointType::revolute;
+      const double margin = revolute ? 4_deg : 20_mm;
+      EXPECT_GE(c[i] - m.joints[i].lower, margin) << m.joints[i].name;
+      EXPECT_GE(m.joints[i].upper - c[i], margin) << m.joints[i].name;
+    }
+  }
+}
+
+constexpr const char* kGoodRobot = R"({
+  "name": "two", "title": "Two links", "source": "test", "solver": "dh",
+  // comments are allowed
+  "joints": [
+    {"name": "j1", "type": "revolute", "a_m": 0.5, "alpha_deg": 0, "lower_deg": -90,
+     "upper_deg": 90, "resolution_deg_per_count": 0.01, "ready_deg": 0},
+    {"name": "j2", "type": "prismatic", "a_m": 0, "alpha_deg": 0, "lower_m": 0, "upper_m": 0.2,
+     "resolution_mm_per_count": 0.01, "ready_m": 0.1}
+  ]
+})";
+
+TEST(RobotFile, ParsesWithUnitsConverted) {
+  const kin::RobotModel m = kin::parse_robot(kGoodRobot, "test");
+  ASSERT_EQ(m.dof(), 2u);
+  EXPECT_EQ(m.solver, kin::SolverKind::dh);
+  EXPECT_DOUBLE_EQ(m.joints[0].upper, 90_deg);
+  EXPECT_DOUBLE_EQ(m.joints[1].resolution_per_count, 1e-5);
+  EXPECT_EQ(m.joints[1].type, kin::JointType::prismatic);
+}
+
+void expect_error(const std::string& text, const std::string& fragment) {
+  try {
+    (void)kin::parse_robot(text, "bad.json");
+    ADD_FAILURE() << "accepted: " << fragment;
+  } catch (const kin::RobotFileError& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find("bad.json"), std::string::npos) << message;
+    EXPECT_NE(message.find(fragment), std::string::npos) << message;
+  }
+}
+
+std::string replaced(std::string text, const std::string& from, const std::string& to) {
+  text.replace(text.find(from), from.size(), to);
+  return text;
+}
+
+TEST(RobotFile, RefusesBadInputWithMessagesThatSayWhere) {
+  expect_error("{ not json", "not valid JSON");
+  expect_error(replaced(kGoodRobot, "\"ready_deg\": 0}", "\"ready_deg\": 0, \"speed\": 1}"),
+               "unknown key \"speed\"");
+  expect_error(replaced(kGoodRobot, "\"solver\": \"dh\"", "\"solver\": \"ikfast\""), "solver");
+  expect_error(replaced(kGoodRobot, "\"type\": \"revolute\"", "\"type\": \"ball\""), "joint 1");
+  expect_error(replaced(kGoodRobot, "\"lower_deg\": -90", "\"lower_deg\": 100"), "lower limit");
+  expect_error(replaced(kGoodRobot, "\"ready_m\": 0.1", "\"ready_m\": 0.5"), "ready");
+  expect_error(replaced(kGoodRobot, "\"a_m\": 0.5", "\"a_m\": \"x\""), "\"a_m\" must be a number");
+  expect_error(replaced(kGoodRobot, "\"name\": \"two\", ", ""), "missing \"name\"");
+}
+
+TEST(RobotFile, LoadsFromDiskAndReportsMissingFiles) {
+  const auto path = std::filesystem::temp_directory_path() / "rccx_robot_test.json";
+  {
+    std::ofstream out(path);
+    out << kGoodRobot;
+  }
+  EXPECT_EQ(kin::load_robot_file(path).name, "two");
+  std::filesystem::remove(path);
+  EXPECT_THROW((void)kin::load_robot_file(path), kin::RobotFileError);
+}
+
+TEST(RobotFile, ClosedFormsRefuseChainsOfAnotherShape) {
+  kin::RobotModel m = kin::builtin_robot("puma560");
+  m.joints[3].dh.alpha_rad = 0.0;
+  EXPECT_THROW((void)kin::make_kinematics(m), kin::RobotFileError);
+  kin::RobotModel microbo = kin::builtin_robot("microbo");
+  microbo.joints[0].dh.a_m = 0.1;
+  EXPECT_THROW((void)kin::make_kinematics(microbo), kin::RobotFileError);
+  // The same chain served numerically is fine.
+  microbo.solver = kin::SolverKind::dh;
+  EXPECT_NO_THROW((void)kin::make_kinematics(microbo));
+}
+
+}  // namespace

@@ -67,22 +67,27 @@ void Rot3::to_axis_angle(Vec3& axis, double& angle_rad) const noexcept {
   const double s2 = w.norm();
   const double c2 = n.x + o.y + a.z - 1.0;  // 2 cos(angle)
   angle_rad = std::atan2(s2, c2);
-  if (s2 > 1e-9) {
-    axis = w / s2;
+  if (c2 >= 0.0) {
+    // Up to a quarter turn w is well conditioned, down to the smallest rotations.
+    axis = s2 > 0.0 ? w / s2 : Vec3{0, 0, 1};
     return;
   }
-  if (c2 > 0) {  // no rotation: any axis
-    axis = {0, 0, 1};
-    angle_rad = 0.0;
-    return;
+  // Beyond a quarter turn w shrinks towards the half turn; read the axis from the symmetric part
+  // instead, (R + Rt)/2 - cos(angle) I = (1 - cos(angle)) k kt, and its sign from w.
+  const double one_minus_c = 1.0 - 0.5 * c2;
+  const double diag[3] = {n.x - 0.5 * c2, o.y - 0.5 * c2, a.z - 0.5 * c2};
+  const int i = diag[0] >= diag[1] ? (diag[0] >= diag[2] ? 0 : 2) : (diag[1] >= diag[2] ? 1 : 2);
+  const double ki = std::sqrt(std::max(diag[i], 0.0) / one_minus_c);
+  const double scale = 1.0 / (one_minus_c * ki);
+  Vec3 k;
+  if (i == 0) {
+    k = {ki, 0.5 * (n.y + o.x) * scale, 0.5 * (n.z + a.x) * scale};
+  } else if (i == 1) {
+    k = {0.5 * (n.y + o.x) * scale, ki, 0.5 * (o.z + a.y) * scale};
+  } else {
+    k = {0.5 * (n.z + a.x) * scale, 0.5 * (o.z + a.y) * scale, ki};
   }
-  // Angle near pi: R = 2 k kᵀ - I, so the axis is the largest column of R + I.
-  const Vec3 cols[3] = {{n.x + 1, n.y, n.z}, {o.x, o.y + 1, o.z}, {a.x, a.y, a.z + 1}};
-  const int best = static_cast<int>(
-      std::max_element(cols, cols + 3,
-                       [](const Vec3& l, const Vec3& r) { return l.norm() < r.norm(); }) -
-      cols);
-  axis = cols[best].normalized();
+  axis = dot(k, w) < 0.0 ? -k : k;
 }
 
 Rot3 Rot3::orthonormalized() const noexcept {
