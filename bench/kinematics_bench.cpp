@@ -35,15 +35,15 @@ using rccx::kin::Kinematics;
 using rccx::kin::RobotModel;
 using rccx::math::Transform;
 
-constexpr std::size_t kPoolSize = 1024;             // samples per pool
-constexpr std::uint64_t kDrawSeed = 19860101;       // joint vectors
-constexpr std::uint64_t kPerturbSeed = 19860102;    // seeds of the numeric solvers
-constexpr double kPerturbation = 0.05;              // rad, +- per joint around the true q
-constexpr double kNearSingular = 1e-3;              // |sin| (or m) below which a sample is skipped
-constexpr double kIkTolerance = 1e-9;               // FK(IK(pose)) vs pose, closed form and DH
-constexpr double kFkTolerance = 1e-12;              // our FK vs the DH chain / KDL
-constexpr double kKdlPositionTolerance = 2e-5;      // m; see check_kdl_ik
-constexpr double kKdlRotationTolerance = 2e-3;      // rotation matrix element
+constexpr std::size_t kPoolSize = 1024;           // samples per pool
+constexpr std::uint64_t kDrawSeed = 19860101;     // joint vectors
+constexpr std::uint64_t kPerturbSeed = 19860102;  // seeds of the numeric solvers
+constexpr double kPerturbation = 0.05;            // rad, +- per joint around the true q
+constexpr double kNearSingular = 1e-3;            // |sin| (or m) below which a sample is skipped
+constexpr double kIkTolerance = 1e-9;             // FK(IK(pose)) vs pose, closed form and DH
+constexpr double kFkTolerance = 1e-12;            // our FK vs the DH chain / KDL
+constexpr double kKdlPositionTolerance = 2e-5;    // m; see check_kdl_ik
+constexpr double kKdlRotationTolerance = 2e-3;    // rotation matrix element
 
 // ---- robots -------------------------------------------------------------------------------
 
@@ -62,9 +62,8 @@ const rccx::kin::DhKinematics& dh_puma() {
 
 KDL::Frame to_kdl(const Transform& t) {
   const auto& R = t.R;
-  return KDL::Frame(
-      KDL::Rotation(R.n.x, R.o.x, R.a.x, R.n.y, R.o.y, R.a.y, R.n.z, R.o.z, R.a.z),
-      KDL::Vector(t.p.x, t.p.y, t.p.z));
+  return KDL::Frame(KDL::Rotation(R.n.x, R.o.x, R.a.x, R.n.y, R.o.y, R.a.y, R.n.z, R.o.z, R.a.z),
+                    KDL::Vector(t.p.x, t.p.y, t.p.z));
 }
 Transform from_kdl(const KDL::Frame& f) {
   return Transform::from_rows({f.M(0, 0), f.M(0, 1), f.M(0, 2), f.p.x(), f.M(1, 0), f.M(1, 1),
@@ -91,9 +90,9 @@ struct KdlPuma {
   explicit KdlPuma(const RobotModel& model) {
     for (const auto& j : model.joints) {
       const bool prismatic = j.type == rccx::kin::JointType::prismatic;
-      chain.addSegment(KDL::Segment(KDL::Joint(prismatic ? KDL::Joint::TransZ : KDL::Joint::RotZ),
-                                    KDL::Frame::DH(j.dh.a_m, j.dh.alpha_rad, j.dh.d_m,
-                                                   j.dh.theta_rad)));
+      chain.addSegment(
+          KDL::Segment(KDL::Joint(prismatic ? KDL::Joint::TransZ : KDL::Joint::RotZ),
+                       KDL::Frame::DH(j.dh.a_m, j.dh.alpha_rad, j.dh.d_m, j.dh.theta_rad)));
     }
     fk = std::make_unique<KDL::ChainFkSolverPos_recursive>(chain);
     ik = std::make_unique<KDL::ChainIkSolverPos_LMA>(chain);  // KDL's defaults: eps 1e-5, 500 it.
@@ -152,7 +151,8 @@ bool near_singular(const Kinematics& k, const JointVector& q) {
   const auto& j = k.model().joints;
   const double a2 = j[1].dh.a_m, a3 = j[2].dh.a_m, d4 = j[3].dh.d_m;
   const double phi = std::atan2(d4, a3);
-  const double reach = a2 * std::cos(q[1]) + a3 * std::cos(q[1] + q[2]) - d4 * std::sin(q[1] + q[2]);
+  const double reach =
+      a2 * std::cos(q[1]) + a3 * std::cos(q[1] + q[2]) - d4 * std::sin(q[1] + q[2]);
   return std::abs(std::sin(q[2] + phi)) < kNearSingular || std::abs(reach) < kNearSingular;
 }
 
@@ -171,8 +171,8 @@ IkPool make_ik_pool(const Kinematics& k) {
     const JointVector q = random_q(model, rng);
     JointVector seed(model.dof());
     for (std::size_t i = 0; i < model.dof(); ++i) {
-      seed[i] = std::clamp(q[i] + perturb(perturb_rng), model.joints[i].lower,
-                           model.joints[i].upper);
+      seed[i] =
+          std::clamp(q[i] + perturb(perturb_rng), model.joints[i].lower, model.joints[i].upper);
     }
     if (near_singular(k, q)) {
       ++pool.skipped_singular;
@@ -318,9 +318,8 @@ NumericCheck check_kdl_ik(const IkPool& pool) {
   c.ok_rate = static_cast<double>(ok) / static_cast<double>(pool.pose.size());
   if (ok == 0) c.error = "KDL LMA solved no sample";
   if (max_position > kKdlPositionTolerance || max_rotation > kKdlRotationTolerance) {
-    c.error = "KDL LMA: FK(IK(pose)) != pose, max position error " +
-              std::to_string(max_position) + " m, rotation element " +
-              std::to_string(max_rotation);
+    c.error = "KDL LMA: FK(IK(pose)) != pose, max position error " + std::to_string(max_position) +
+              " m, rotation element " + std::to_string(max_rotation);
   }
   return c;
 }
@@ -334,9 +333,8 @@ bool checked(benchmark::State& state, const std::string& error) {
 
 void pool_counters(benchmark::State& state, const IkPool& pool) {
   state.counters["pool"] = static_cast<double>(pool.pose.size());
-  state.counters["skipped"] =
-      static_cast<double>(pool.skipped_singular + pool.skipped_unsolved) /
-      static_cast<double>(pool.drawn);
+  state.counters["skipped"] = static_cast<double>(pool.skipped_singular + pool.skipped_unsolved) /
+                              static_cast<double>(pool.drawn);
 }
 
 // ---- FK -----------------------------------------------------------------------------------
@@ -429,8 +427,8 @@ void BM_Puma560IKAll(benchmark::State& state) {
     if (++i == n) i = 0;
   }
   pool_counters(state, pool);
-  state.counters["solutions"] = benchmark::Counter(static_cast<double>(solutions),
-                                                   benchmark::Counter::kAvgIterations);
+  state.counters["solutions"] =
+      benchmark::Counter(static_cast<double>(solutions), benchmark::Counter::kAvgIterations);
 }
 
 void BM_DhIK(benchmark::State& state) {

@@ -66,7 +66,9 @@ bool all_finite(const kin::JointVector& q) {
 // sin(theta5), so near the wrist singularity their error grows as 1/|sin(theta5)|.
 // Near the stretched elbow theta2 and theta3 lose precision the same way; 1e-9 rad is far below
 // any difference between configurations.
-double joint_tolerance(double sin_theta5) { return std::max(1e-9, 1e-14 / std::abs(sin_theta5)); }
+double joint_tolerance(double sin_theta5) {
+  return std::max(1e-9, 1e-14 / std::abs(sin_theta5));
+}
 
 class EveryRobot : public ::testing::TestWithParam<const char*> {};
 INSTANTIATE_TEST_SUITE_P(Kinematics, EveryRobot, ::testing::ValuesIn(kRobots));
@@ -170,7 +172,8 @@ TEST_P(EveryRobot, ConfigurationsGiveDistinctSolutionsOfTheSamePose) {
     for (std::size_t b = a + 1; b < all.count; ++b) {
       double d = 0.0;
       for (std::size_t j = 0; j < 6; ++j) {
-        d = std::max(d, std::abs(std::remainder(all.items[a].q[j] - all.items[b].q[j], 2 * math::kPi)));
+        d = std::max(
+            d, std::abs(std::remainder(all.items[a].q[j] - all.items[b].q[j], 2 * math::kPi)));
       }
       EXPECT_GT(d, 1e-3) << k->configuration_name(all.items[a].configuration) << " vs "
                          << k->configuration_name(all.items[b].configuration);
@@ -221,8 +224,7 @@ TEST(Puma560, PublishedPoses) {
   const auto k = kin::make_kinematics(kin::builtin_robot("puma560"));
   // Zero pose: p = (0.4521, -0.15005, 0.4318) m, R = I.
   const math::Transform zero = k->forward({0, 0, 0, 0, 0, 0});
-  EXPECT_LT(math::max_abs_difference(
-                zero, math::Transform::translation(0.4521, -0.15005, 0.4318)),
+  EXPECT_LT(math::max_abs_difference(zero, math::Transform::translation(0.4521, -0.15005, 0.4318)),
             1e-15);
   // Corke, Robotics, Vision and Control: qr (arm straight up) and qn (nominal) poses.
   const math::Transform ready = k->forward({0, 90_deg, -90_deg, 0, 0, 0});
@@ -264,8 +266,7 @@ TEST(Puma560, ConfigurationsMeanWhatTheirNamesSay) {
     const double C1 = std::cos(q[0]), S1 = std::sin(q[0]);
     const math::Vec3 x1{C1, S1, 0};
     const math::Vec3 wrist = k->forward(q).p;
-    const math::Vec3 elbow{a2 * std::cos(q[1]) * C1, a2 * std::cos(q[1]) * S1,
-                           a2 * std::sin(q[1])};
+    const math::Vec3 elbow{a2 * std::cos(q[1]) * C1, a2 * std::cos(q[1]) * S1, a2 * std::sin(q[1])};
     const double wrist_reach = math::dot(wrist, x1);
     EXPECT_EQ(name[0], wrist_reach >= 0 ? 'r' : 'l') << i;
     // Elbow above the shoulder-wrist line, measured in the vertical plane of the arm.
@@ -405,9 +406,9 @@ TEST(Microbo, Theta5AtMinusPiKeepsThePreviousTheta4) {
 TEST(Microbo, PosesBeyondTheSlidesAreOutOfJointLimits) {
   const auto k = kin::make_kinematics(kin::builtin_robot("microbo"));
   const math::Rot3 down = math::Rot3::rot_x(180_deg);
-  EXPECT_EQ(k->inverse({down, {0.5, 0.0, 0.25}}).status, kin::IkStatus::joint_limits);  // d3
-  EXPECT_EQ(k->inverse({down, {0.3, 0.0, 0.5}}).status, kin::IkStatus::joint_limits);   // d2
-  EXPECT_EQ(k->inverse({down, {-0.3, 0.0, 0.25}}).status, kin::IkStatus::joint_limits); // theta1
+  EXPECT_EQ(k->inverse({down, {0.5, 0.0, 0.25}}).status, kin::IkStatus::joint_limits);   // d3
+  EXPECT_EQ(k->inverse({down, {0.3, 0.0, 0.5}}).status, kin::IkStatus::joint_limits);    // d2
+  EXPECT_EQ(k->inverse({down, {-0.3, 0.0, 0.25}}).status, kin::IkStatus::joint_limits);  // theta1
   // On joint 1's axis: theta1 is free, but d3 = 0 is below its limit.
   EXPECT_EQ(k->inverse({down, {0.0, 0.0, 0.25}}).status, kin::IkStatus::joint_limits);
 }

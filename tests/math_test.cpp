@@ -54,7 +54,8 @@ TEST_F(RandomFrames, RotationAboutAnAxisMatchesEigenAngleAxis) {
   for (int i = 0; i < 1000; ++i) {
     const Vec3 k = random_axis();
     const double theta = angle(rng);
-    const Eigen::Matrix3d expected = Eigen::AngleAxisd(theta, Eigen::Vector3d(k.x, k.y, k.z)).matrix();
+    const Eigen::Matrix3d expected =
+        Eigen::AngleAxisd(theta, Eigen::Vector3d(k.x, k.y, k.z)).matrix();
     EXPECT_LT((to_eigen(Rot3::about(k * 3.0, theta)) - expected).cwiseAbs().maxCoeff(), 4e-15);
   }
 }

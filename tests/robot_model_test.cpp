@@ -41,7 +41,7 @@ TEST(BuiltinRobots, Puma560IsCorkesStandardDhModel) {
 // are enough; the others fit in 16 bits.
 TEST(BuiltinRobots, MicroboRangesFitItsEncoders) {
   const kin::RobotModel m = kin::builtin_robot("microbo");
-  const double thesis_resolution[6] = {0.0031_deg, 0.0020_mm, 0.0013_mm,
+  const double thesis_resolution[6] = {0.0031_deg, 0.0020_mm,  0.0013_mm,
                                        0.0041_deg, 0.0056_deg, 0.0182_deg};
   for (std::size_t i = 0; i < 6; ++i) {
     const kin::Joint& j = m.joints[i];

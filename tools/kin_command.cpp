@@ -47,18 +47,21 @@ void add_robot_options(CLI::App& cmd, RobotChoice& robot) {
       ->check(CLI::ExistingFile);
 }
 
-std::string unit_of(const kin::Joint& j) { return j.type == kin::JointType::revolute ? "rad" : "m"; }
+std::string unit_of(const kin::Joint& j) {
+  return j.type == kin::JointType::revolute ? "rad" : "m";
+}
 
 /// Joint values given by the user, in rad/m, or in deg/m when `degrees` is set.
 kin::JointVector joints_from(const std::vector<double>& values, const kin::Kinematics& k,
                              bool degrees, const char* what) {
   if (values.size() != k.dof()) {
-    throw BadArgument{fmt::format("{}: robot {} has {} joints, got {} values", what,
-                                  k.model().name, k.dof(), values.size())};
+    throw BadArgument{fmt::format("{}: robot {} has {} joints, got {} values", what, k.model().name,
+                                  k.dof(), values.size())};
   }
   kin::JointVector q(k.dof());
   for (std::size_t i = 0; i < k.dof(); ++i) {
-    if (!std::isfinite(values[i])) throw BadArgument{fmt::format("{}: value {} is not finite", what, i + 1)};
+    if (!std::isfinite(values[i]))
+      throw BadArgument{fmt::format("{}: value {} is not finite", what, i + 1)};
     const bool revolute = k.model().joints[i].type == kin::JointType::revolute;
     q[i] = degrees && revolute ? math::deg_to_rad(values[i]) : values[i];
   }
@@ -75,7 +78,9 @@ void warn_outside_limits(const kin::Kinematics& k, const kin::JointVector& q) {
   }
 }
 
-json to_json(const kin::JointVector& q) { return json(std::vector<double>(q.begin(), q.end())); }
+json to_json(const kin::JointVector& q) {
+  return json(std::vector<double>(q.begin(), q.end()));
+}
 
 std::string format_joints(const kin::Kinematics& k, const kin::JointVector& q) {
   std::string out;
@@ -139,8 +144,8 @@ struct IkArgs {
 
 math::Transform pose_from(const std::vector<double>& values) {
   if (values.size() != 12) {
-    throw BadArgument{fmt::format("--T takes 12 numbers (r11,r12,r13,px,...,r33,pz), got {}",
-                                  values.size())};
+    throw BadArgument{
+        fmt::format("--T takes 12 numbers (r11,r12,r13,px,...,r33,pz), got {}", values.size())};
   }
   std::array<double, 12> m{};
   for (std::size_t i = 0; i < 12; ++i) {
@@ -234,12 +239,12 @@ int run_ik(const IkArgs& args) {
   }
   report_singularity(r);
   if (args.json) {
-    fmt::print("{}\n",
-               json{{"robot", k->model().name}, {"q", to_json(r.q)}, {"config", config_name(r)}}
-                   .dump());
+    fmt::print(
+        "{}\n",
+        json{{"robot", k->model().name}, {"q", to_json(r.q)}, {"config", config_name(r)}}.dump());
   } else {
-    fmt::print("{} ({}), configuration {}:\n{}", k->model().name, k->model().title,
-               config_name(r), format_joints(*k, r.q));
+    fmt::print("{} ({}), configuration {}:\n{}", k->model().name, k->model().title, config_name(r),
+               format_joints(*k, r.q));
   }
   return kOk;
 }
@@ -322,8 +327,9 @@ void add_kin_command(CLI::App& app, int& exit_code) {
 
   auto ik = std::make_shared<IkArgs>();
   CLI::App* ik_cmd = kin->add_subcommand(
-      "ik", "Inverse kinematics: joint values within limits for a T6 pose. Exit code 3 when the "
-            "pose cannot be reached (the reason goes to stderr), 2 for bad arguments");
+      "ik",
+      "Inverse kinematics: joint values within limits for a T6 pose. Exit code 3 when the "
+      "pose cannot be reached (the reason goes to stderr), 2 for bad arguments");
   add_robot_options(*ik_cmd, ik->robot);
   ik_cmd
       ->add_option("--T", ik->T,
@@ -335,11 +341,13 @@ void add_kin_command(CLI::App& app, int& exit_code) {
       "--config", ik->config,
       "Configuration to solve for: PUMA l|r (arm) u|d (elbow) n|f (wrist), e.g. lun; Microbo n|f "
       "(wrist)");
-  CLI::Option* near_opt = ik_cmd->add_option(
-      "--near", ik->near,
-      "Comma-separated joint values (rad or m; with --deg, deg or m) to stay closest to; "
-      "default: the robot's ready pose")
-      ->delimiter(',');
+  CLI::Option* near_opt =
+      ik_cmd
+          ->add_option(
+              "--near", ik->near,
+              "Comma-separated joint values (rad or m; with --deg, deg or m) to stay closest to; "
+              "default: the robot's ready pose")
+          ->delimiter(',');
   config_opt->excludes(near_opt);
   ik_cmd->add_flag("--all", ik->all, "Print every configuration's solution within limits");
   ik_cmd->add_flag("--deg", ik->degrees, "--near is in degrees for revolute joints");

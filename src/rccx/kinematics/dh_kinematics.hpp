@@ -12,8 +12,8 @@ struct DhSolverSettings {
   int max_iterations = 100;
   double position_tolerance_m = 1e-12;
   double orientation_tolerance_rad = 1e-12;
-  double damping = 1e-4;             ///< lambda of (J Jt + lambda^2 I)
-  double max_step_rad_or_m = 0.5;    ///< largest joint change per iteration
+  double damping = 1e-4;           ///< lambda of (J Jt + lambda^2 I)
+  double max_step_rad_or_m = 0.5;  ///< largest joint change per iteration
 };
 
 class DhKinematics final : public Kinematics {

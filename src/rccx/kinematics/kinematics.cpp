@@ -68,8 +68,8 @@ std::string_view to_string(Singularity s) noexcept {
 Kinematics::Kinematics(RobotModel model) : model_(std::move(model)) {
   for (std::size_t i = 0; i < model_.dof(); ++i) {
     const Joint& j = model_.joints[i];
-    links_[i] = {j.dh.a_m,         std::cos(j.dh.alpha_rad), std::sin(j.dh.alpha_rad),
-                 j.dh.d_m,         j.dh.theta_rad,           j.type == JointType::prismatic};
+    links_[i] = {j.dh.a_m, std::cos(j.dh.alpha_rad), std::sin(j.dh.alpha_rad),
+                 j.dh.d_m, j.dh.theta_rad,           j.type == JointType::prismatic};
     // cos(pi/2) is 6e-17, not 0; snap so that the DH chain is exact for the usual right angles.
     if (std::abs(links_[i].ca) < 1e-15) links_[i].ca = 0.0;
     if (std::abs(links_[i].sa) < 1e-15) links_[i].sa = 0.0;

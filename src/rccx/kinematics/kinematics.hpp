@@ -58,7 +58,9 @@ struct IkSolutions {
   std::array<IkResult, kMaxIkSolutions> items{};
   std::size_t count = 0;
   IkStatus status = IkStatus::ok;  ///< why there are none, when count is 0
-  [[nodiscard]] std::span<const IkResult> solutions() const noexcept { return {items.data(), count}; }
+  [[nodiscard]] std::span<const IkResult> solutions() const noexcept {
+    return {items.data(), count};
+  }
 };
 
 struct IkOptions {
@@ -115,7 +117,8 @@ class Kinematics {
     return {};
   }
   /// The configuration with that name, if any.
-  [[nodiscard]] std::optional<Configuration> find_configuration(std::string_view name) const noexcept;
+  [[nodiscard]] std::optional<Configuration> find_configuration(
+      std::string_view name) const noexcept;
   [[nodiscard]] std::string_view configuration_name(Configuration c) const noexcept;
 
  protected:

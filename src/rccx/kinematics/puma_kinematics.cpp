@@ -32,8 +32,8 @@ PumaKinematics::PumaKinematics(RobotModel model) : AnalyticKinematics(std::move(
     const Joint& j = m.joints[i];
     if (j.type != JointType::revolute) fail(fmt::format("joint {} is not revolute", i + 1));
     if (std::abs(j.dh.alpha_rad - math::deg_to_rad(kAlphaDeg[i])) > 1e-12) {
-      fail(fmt::format("joint {} has alpha {} deg, not {}", i + 1,
-                       math::rad_to_deg(j.dh.alpha_rad), kAlphaDeg[i]));
+      fail(fmt::format("joint {} has alpha {} deg, not {}", i + 1, math::rad_to_deg(j.dh.alpha_rad),
+                       kAlphaDeg[i]));
     }
     if (std::abs(j.dh.theta_rad) > 1e-12) fail(fmt::format("joint {} has a theta offset", i + 1));
     const bool a_allowed = i == 1 || i == 2;

@@ -29,8 +29,8 @@ struct Joint {
   std::string name;
   JointType type = JointType::revolute;
   DhParameters dh;
-  double lower = 0.0;  ///< lower limit, rad or m
-  double upper = 0.0;  ///< upper limit, rad or m
+  double lower = 0.0;                 ///< lower limit, rad or m
+  double upper = 0.0;                 ///< upper limit, rad or m
   double resolution_per_count = 0.0;  ///< encoder resolution, rad or m per count
   double ready = 0.0;                 ///< value in the robot's ready (nominal) pose, rad or m
 };

@@ -36,7 +36,9 @@ struct Vec3 {
   }
 };
 
-constexpr Vec3 operator*(double s, const Vec3& v) noexcept { return v * s; }
+constexpr Vec3 operator*(double s, const Vec3& v) noexcept {
+  return v * s;
+}
 constexpr double dot(const Vec3& a, const Vec3& b) noexcept {
   return a.x * b.x + a.y * b.y + a.z * b.z;
 }

@@ -8,8 +8,12 @@ namespace rccx::math {
 
 inline constexpr double kPi = std::numbers::pi;
 
-constexpr double deg_to_rad(double deg) noexcept { return deg * (kPi / 180.0); }
-constexpr double rad_to_deg(double rad) noexcept { return rad * (180.0 / kPi); }
+constexpr double deg_to_rad(double deg) noexcept {
+  return deg * (kPi / 180.0);
+}
+constexpr double rad_to_deg(double rad) noexcept {
+  return rad * (180.0 / kPi);
+}
 
 namespace literals {
 // clang-format off
