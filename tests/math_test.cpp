@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <random>
 
+#include "rccx/math/batch_trig.hpp"
 #include "rccx/math/transform.hpp"
 #include "rccx/math/units.hpp"
 
@@ -206,6 +207,52 @@ TEST_F(RandomFrames, DriveTransformMovesAsPaulDescribes) {
   EXPECT_NEAR(spin.theta_rad(), 0.0, 1e-15);
   EXPECT_NEAR(spin.phi_rad(), 1.2, 1e-15);
   EXPECT_LT(max_diff(spin.at(0.5).R, Rot3::rot_z(0.6)), 1e-15);
+}
+
+}  // namespace
+
+namespace {
+
+TEST(BatchTrig, BothImplementationsAgreeWithGlibc) {
+  using namespace rccx::math;
+  std::mt19937_64 rng(8);
+  std::uniform_real_distribution<double> wide(-20.0, 20.0), unit(-1.0, 1.0);
+  auto check = [](const double* y, const double* x, const double* angle) {
+    double s[4], c[4], at[4];
+    detail::sincos4_scalar(angle, s, c);
+    detail::atan2_4_scalar(y, x, at);
+    for (int i = 0; i < 4; ++i) {
+      EXPECT_EQ(s[i], std::sin(angle[i]));
+      EXPECT_EQ(at[i], std::atan2(y[i], x[i]));
+    }
+    if (!batch_trig_uses_avx2()) return;
+    double sv[4], cv[4], atv[4];
+    detail::sincos4_avx2(angle, sv, cv);
+    detail::atan2_4_avx2(y, x, atv);
+    for (int i = 0; i < 4; ++i) {
+      EXPECT_NEAR(sv[i], s[i], 1e-15) << angle[i];
+      EXPECT_NEAR(cv[i], c[i], 1e-15) << angle[i];
+      EXPECT_NEAR(atv[i], at[i], 2e-15) << y[i] << " " << x[i];
+    }
+  };
+  for (int n = 0; n < 2000; ++n) {
+    double y[4], x[4], angle[4];
+    for (int i = 0; i < 4; ++i) {
+      y[i] = unit(rng);
+      x[i] = unit(rng);
+      angle[i] = wide(rng);
+    }
+    check(y, x, angle);
+  }
+  // The edges the kinematics meet: zeros, signed zeros, half turns.
+  const double y[4] = {0.0, -0.0, 0.0, 1e-300};
+  const double x[4] = {0.0, -1.0, -1.0, -1.0};
+  const double angle[4] = {0.0, kPi, -kPi, 2 * kPi};
+  check(y, x, angle);
+  double out[4];
+  atan2_4(y, x, out);
+  EXPECT_EQ(out[0], 0.0);
+  EXPECT_EQ(out[2], kPi);
 }
 
 }  // namespace

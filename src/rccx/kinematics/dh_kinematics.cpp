@@ -15,8 +15,8 @@ math::Transform DhKinematics::forward(const JointVector& q) const noexcept {
 IkResult DhKinematics::inverse(const math::Transform& pose,
                                const IkOptions& options) const noexcept {
   IkResult result;
-  const auto reference = reference_pose(options);
-  if (!reference) return result;  // bad_input
+  const JointVector* const reference = reference_pose(options);
+  if (reference == nullptr) return result;  // bad_input
   for (double v : pose.rows()) {
     if (!std::isfinite(v)) return result;
   }
@@ -45,7 +45,11 @@ IkResult DhKinematics::inverse(const math::Transform& pose,
     Eigen::Matrix<double, 6, 6> JJt = J * J.transpose();
     JJt.diagonal().array() += lambda2;
     const Eigen::Matrix<double, 6, 1> y = JJt.ldlt().solve(e);
-    Eigen::Matrix<double, Eigen::Dynamic, 1, Eigen::ColMajor, kMaxJoints, 1> dq = J.transpose() * y;
+    // All kMaxJoints entries written: GCC cannot see that a runtime-sized vector is, and warns
+    // (-Wmaybe-uninitialized) on the vectorised maxCoeff.
+    Eigen::Matrix<double, kMaxJoints, 1> dq_all = Eigen::Matrix<double, kMaxJoints, 1>::Zero();
+    auto dq = dq_all.head(J.cols());
+    dq.noalias() = J.transpose() * y;
     const double largest = dq.cwiseAbs().maxCoeff();
     if (largest > settings_.max_step_rad_or_m) dq *= settings_.max_step_rad_or_m / largest;
     bool moved = false;

@@ -73,7 +73,13 @@ Kinematics::Kinematics(RobotModel model) : model_(std::move(model)) {
     // cos(pi/2) is 6e-17, not 0; snap so that the DH chain is exact for the usual right angles.
     if (std::abs(links_[i].ca) < 1e-15) links_[i].ca = 0.0;
     if (std::abs(links_[i].sa) < 1e-15) links_[i].sa = 0.0;
+    const double lo = j.lower - kLimitTolerance;
+    const double hi = j.upper + kLimitTolerance;
+    const bool revolute = j.type == JointType::revolute;
+    // The widened range, so that a value within it never has a second turn within it too.
+    limits_[i] = {j.lower, j.upper, lo, hi, revolute, revolute && hi - lo >= 2.0 * math::kPi};
   }
+  ready_ = model_.ready();
 }
 
 std::optional<Configuration> Kinematics::find_configuration(std::string_view name) const noexcept {
@@ -89,32 +95,45 @@ std::string_view Kinematics::configuration_name(Configuration c) const noexcept 
   return c.index < names.size() ? names[c.index] : std::string_view{};
 }
 
-std::optional<JointVector> Kinematics::reference_pose(const IkOptions& options) const noexcept {
-  if (!options.near) return model_.ready();
-  if (options.near->size() != dof()) return std::nullopt;
+const JointVector* Kinematics::reference_pose(const IkOptions& options) const noexcept {
+  if (!options.near) return &ready_;
+  if (options.near->size() != dof()) return nullptr;
   for (double v : *options.near) {
-    if (!std::isfinite(v)) return std::nullopt;
+    if (!std::isfinite(v)) return nullptr;
   }
-  return *options.near;
+  return &*options.near;
 }
 
 bool Kinematics::fit_to_limits(JointVector& q, const JointVector& toward) const noexcept {
   constexpr double kTurn = 2.0 * math::kPi;
+  constexpr double kInvTurn = 1.0 / kTurn;
   for (std::size_t i = 0; i < dof(); ++i) {
-    const Joint& j = model_.joints[i];
-    const double lo = j.lower - kLimitTolerance;
-    const double hi = j.upper + kLimitTolerance;
+    const Limit& l = limits_[i];
     double v = q[i];
-    if (j.type == JointType::revolute) {
+    // Less than a turn of range: a value within limits has no other turn within them.
+    if (!l.multi_turn && v >= l.lo && v <= l.hi) {
+      q[i] = std::clamp(v, l.lower, l.upper);
+      continue;
+    }
+    if (l.revolute) {
+      if (!l.multi_turn) {
+        // Raw IK angles are in (-pi, pi], so one turn either way is the only candidate; the
+        // general case below still covers other inputs.
+        const double w = v < l.lo ? v + kTurn : v - kTurn;
+        if (w >= l.lo && w <= l.hi) {
+          q[i] = std::clamp(w, l.lower, l.upper);
+          continue;
+        }
+      }
       // Whole turns that bring v within limits: k_lo..k_hi; the one nearest `toward` wins.
-      const double k_lo = std::ceil((lo - v) / kTurn);
-      const double k_hi = std::floor((hi - v) / kTurn);
+      const double k_lo = std::ceil((l.lo - v) * kInvTurn);
+      const double k_hi = std::floor((l.hi - v) * kInvTurn);
       if (k_lo > k_hi) return false;
-      const double k_near = std::round((toward[i] - v) / kTurn);
+      const double k_near = std::nearbyint((toward[i] - v) * kInvTurn);
       v += kTurn * std::clamp(k_near, k_lo, k_hi);
     }
-    if (!(v >= lo && v <= hi)) return false;
-    q[i] = std::clamp(v, j.lower, j.upper);
+    if (!(v >= l.lo && v <= l.hi)) return false;
+    q[i] = std::clamp(v, l.lower, l.upper);
   }
   return true;
 }
@@ -152,8 +171,8 @@ IkSolutions Kinematics::inverse_all(const math::Transform& pose,
 IkResult AnalyticKinematics::inverse(const math::Transform& pose,
                                      const IkOptions& options) const noexcept {
   IkResult best;
-  const auto reference = reference_pose(options);
-  if (!reference || !finite_pose(pose)) return best;  // bad_input
+  const JointVector* const reference = reference_pose(options);
+  if (reference == nullptr || !finite_pose(pose)) return best;  // bad_input
   const auto names = configuration_names();
   if (options.configuration) {
     if (options.configuration->index >= names.size()) {
@@ -190,8 +209,8 @@ IkResult AnalyticKinematics::inverse(const math::Transform& pose,
 IkSolutions AnalyticKinematics::inverse_all(const math::Transform& pose,
                                             const IkOptions& options) const noexcept {
   IkSolutions all;
-  const auto reference = reference_pose(options);
-  if (!reference || !finite_pose(pose)) {
+  const JointVector* const reference = reference_pose(options);
+  if (reference == nullptr || !finite_pose(pose)) {
     all.status = IkStatus::bad_input;
     return all;
   }

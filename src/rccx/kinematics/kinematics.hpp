@@ -125,9 +125,9 @@ class Kinematics {
   /// Moves each revolute joint of q by whole turns to the value within limits closest to
   /// `toward`, and checks prismatic ones. False when some joint cannot be brought within limits.
   bool fit_to_limits(JointVector& q, const JointVector& toward) const noexcept;
-  /// `near` when given and of the right size, else the ready pose; nullopt when it is given with
-  /// the wrong size.
-  std::optional<JointVector> reference_pose(const IkOptions& options) const noexcept;
+  /// `near` when given, else the ready pose; nullptr when `near` has the wrong size or
+  /// non-finite values. Points into `options` or *this: nothing is copied.
+  const JointVector* reference_pose(const IkOptions& options) const noexcept;
 
   /// T6 by multiplying the DH chain's A matrices (thesis eq. 3.11); frames[i], when given,
   /// receives A1 ... A(i+1), the frame of link i+1.
@@ -142,7 +142,17 @@ class Kinematics {
   std::array<Link, kMaxJoints> links_{};
 
  private:
+  /// Per-joint limit constants for fit_to_limits, which runs on every inverse call.
+  struct Limit {
+    double lower, upper;  ///< the limits
+    double lo, hi;        ///< the limits widened by kLimitTolerance
+    bool revolute;
+    bool multi_turn;  ///< revolute with a turn or more of (widened) range
+  };
+
   RobotModel model_;
+  std::array<Limit, kMaxJoints> limits_{};
+  JointVector ready_;  ///< model_.ready(), which builds a new vector each call
 };
 
 /// Closed-form solvers enumerate one raw solution per configuration; this base turns them into

@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 
+#include "rccx/math/batch_trig.hpp"
 #include "rccx/math/units.hpp"
 
 namespace rccx::kin {
@@ -67,11 +68,11 @@ Configuration MicroboKinematics::configuration_of(const JointVector& q) const no
 
 math::Transform MicroboKinematics::forward(const JointVector& q) const noexcept {
   // Section 3.5: o, a and p from the closed form, then n = o x a (30 mult, 13 add in the thesis).
-  double S1, C1, S4, C4, S5, C5, S6, C6;
-  ::sincos(q[0], &S1, &C1);
-  ::sincos(q[3], &S4, &C4);
-  ::sincos(q[4], &S5, &C5);
-  ::sincos(q[5], &S6, &C6);
+  const double angles[4] = {q[0], q[3], q[4], q[5]};
+  double s[4], c[4];
+  math::sincos4(angles, s, c);
+  const double S1 = s[0], C1 = c[0], S4 = s[1], C4 = c[1], S5 = s[2], C5 = c[2], S6 = s[3],
+               C6 = c[3];
   const double d2 = q[1], d3 = q[2];
   const double u = C6 * S4 - C4 * C5 * S6;
   const double S5S6 = S5 * S6;
@@ -89,47 +90,57 @@ IkStatus MicroboKinematics::solve(const math::Transform& pose, Configuration whi
   out.q = JointVector(6);
   out.configuration = which;
   out.singularity = Singularity::none;
+  // Every angle follows from its sine and cosine, and those follow from the pose without any
+  // angle: collect them and take the four atan2 at once.
+  double y[4], x[4];
 
   // Joints 1-3 from p (eq. 3.14); d3 is the positive root by the robot's geometry.
-  const double d3 = std::hypot(p.x, p.y);
+  const double d3 = std::sqrt(p.x * p.x + p.y * p.y);
+  const bool shoulder_free = !(d3 > kSingular);  // wrist on joint 1's axis: any theta1 will do
   double S1, C1;
-  if (d3 > kSingular) {
+  if (shoulder_free) {
+    ::sincos(reference[0], &S1, &C1);
+  } else {
     S1 = p.y / d3;
     C1 = p.x / d3;
-    out.q[0] = std::atan2(p.y, p.x);
-  } else {  // wrist on joint 1's axis: any theta1 will do, keep the reference one
-    out.q[0] = reference[0];
-    ::sincos(out.q[0], &S1, &C1);
-    out.singularity = Singularity::shoulder;
   }
+  y[0] = S1;
+  x[0] = C1;
   out.q[1] = p.z;
   out.q[2] = d3;
 
   // Joint 4 from the third column of U4: (C4 S5, S4 S5) = (a_y C1 - a_x S1, a_z).
   const double c4s5 = a.y * C1 - a.x * S1;
   const double s4s5 = a.z;
-  const double abs_s5 = std::hypot(c4s5, s4s5);
-  const double sign = which.index == 0 ? -1.0 : 1.0;  // sign of S5
+  const double abs_s5 = std::sqrt(c4s5 * c4s5 + s4s5 * s4s5);
+  const double S5 = which.index == 0 ? -abs_s5 : abs_s5;
+  const bool wrist_free = !(abs_s5 > kSingular);  // theta5 = -pi: joints 4 and 6 aligned
   double S4, C4;
-  const double S5 = sign * abs_s5;
-  if (abs_s5 > kSingular) {
+  if (wrist_free) {
+    ::sincos(reference[3], &S4, &C4);
+  } else {
     S4 = s4s5 / S5;
     C4 = c4s5 / S5;
-    out.q[3] = std::atan2(S4, C4);
-  } else {  // theta5 = -pi: joints 4 and 6 aligned, keep the reference theta4
-    out.q[3] = reference[3];
-    ::sincos(out.q[3], &S4, &C4);
-    out.singularity = Singularity::wrist;
   }
+  y[1] = S4;
+  x[1] = C4;
   // Joint 5 from U5 (erratum: a_y S1 + a_x C1).
-  const double C5 = -(a.y * S1 + a.x * C1);
-  out.q[4] = std::atan2(S5, C5);
+  y[2] = S5;
+  x[2] = -(a.y * S1 + a.x * C1);
   // Joint 6 from the second column of U6.
   const double oxy = o.y * S1 + C1 * o.x;
   const double oyx = C1 * o.y - o.x * S1;
-  const double S6 = -(oxy * S5 + C5 * (o.z * S4 + C4 * oyx));
-  const double C6 = oyx * S4 - C4 * o.z;
-  out.q[5] = std::atan2(S6, C6);
+  y[3] = -(oxy * S5 + x[2] * (o.z * S4 + C4 * oyx));
+  x[3] = oyx * S4 - C4 * o.z;
+
+  double angle[4];
+  math::atan2_4(y, x, angle);
+  out.q[0] = shoulder_free ? reference[0] : angle[0];
+  out.q[3] = wrist_free ? reference[3] : angle[1];
+  out.q[4] = angle[2];
+  out.q[5] = angle[3];
+  if (shoulder_free) out.singularity = Singularity::shoulder;
+  if (wrist_free) out.singularity = Singularity::wrist;
   return IkStatus::ok;
 }
 

@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 
+#include "rccx/math/batch_trig.hpp"
 #include "rccx/math/units.hpp"
 
 namespace rccx::kin {
@@ -69,14 +70,13 @@ Configuration PumaKinematics::configuration_of(const JointVector& q) const noexc
 }
 
 math::Transform PumaKinematics::forward(const JointVector& q) const noexcept {
-  double S1, C1, S2, C2, S3, C3, S4, C4, S5, C5, S6, C6;
-  ::sincos(q[0], &S1, &C1);
-  ::sincos(q[1], &S2, &C2);
-  ::sincos(q[2], &S3, &C3);
-  ::sincos(q[3], &S4, &C4);
-  ::sincos(q[4], &S5, &C5);
-  ::sincos(q[5], &S6, &C6);
-  const double S23 = S2 * C3 + C2 * S3, C23 = C2 * C3 - S2 * S3;
+  const double first[4] = {q[0], q[1], q[3], q[4]};
+  const double second[4] = {q[5], q[1] + q[2], 0.0, 0.0};
+  double s[8], c[8];
+  math::sincos4(first, s, c);
+  math::sincos4(second, s + 4, c + 4);
+  const double S1 = s[0], C1 = c[0], S2 = s[1], C2 = c[1], S4 = s[2], C4 = c[2], S5 = s[3],
+               C5 = c[3], S6 = s[4], C6 = c[4], S23 = s[5], C23 = c[5];
   // R03 by columns, and R36 = R4 R5 R6 by columns.
   const math::Vec3 c0{C1 * C23, S1 * C23, S23};
   const math::Vec3 c1{-S1, C1, 0.0};
@@ -105,6 +105,9 @@ IkStatus PumaKinematics::solve(const math::Transform& pose, Configuration which,
   out.q = JointVector(6);
   out.configuration = which;
   out.singularity = Singularity::none;
+  // Sines and cosines come from the pose without any angle; the six atan2 are taken in two
+  // batches at the end: y/x[0..3] for theta1, theta2, theta3, theta5; [4..5] theta4, theta6.
+  double y[8] = {}, x[8] = {};
 
   const math::Vec3 w = pose.p - pose.R.a * d6_;  // wrist centre
   const double z = w.z - d1_;
@@ -115,16 +118,17 @@ IkStatus PumaKinematics::solve(const math::Transform& pose, Configuration which,
   if (rho2 < -1e-12) return IkStatus::out_of_reach;  // inside the cylinder of radius |d3|
   const double arm = right ? 1.0 : -1.0;
   const double rho = arm * std::sqrt(std::max(rho2, 0.0));
+  const bool shoulder_free = !(r2 > kSingular * kSingular);  // wrist on joint 1's axis (d3 = 0)
   double S1, C1;
-  if (r2 > kSingular * kSingular) {
+  if (shoulder_free) {
+    ::sincos(reference[0], &S1, &C1);
+    out.singularity = Singularity::shoulder;
+  } else {
     C1 = (rho * w.x - d3_ * w.y) / r2;
     S1 = (d3_ * w.x + rho * w.y) / r2;
-    out.q[0] = std::atan2(S1, C1);
-  } else {  // wrist centre on joint 1's axis (only when d3 = 0): keep the reference theta1
-    out.q[0] = reference[0];
-    ::sincos(out.q[0], &S1, &C1);
-    out.singularity = Singularity::shoulder;
   }
+  y[0] = S1;
+  x[0] = C1;
 
   // Joints 2 and 3: a planar two-link problem in the arm's plane, wrist at (rho, z).
   const double D = rho * rho + z * z;
@@ -135,18 +139,20 @@ IkStatus PumaKinematics::solve(const math::Transform& pose, Configuration which,
   const double s = elbow * std::sqrt(1.0 - cc * cc);
   const double C3 = cc * cphi_ + s * sphi_;
   const double S3 = s * cphi_ - cc * sphi_;
-  out.q[2] = std::atan2(S3, C3);
-  const double X = a2_ + L_ * cc, Y = L_ * s;  // wrist in frame 2
+  y[2] = S3;
+  x[2] = C3;
+  const double X = a2_ + L_ * cc, Y = L_ * s;            // wrist in frame 2
+  const bool elbow_free = !(D > kSingular * kSingular);  // wrist on the shoulder (a2 = L only)
   double S2, C2;
-  if (D > kSingular * kSingular) {
+  if (elbow_free) {
+    ::sincos(reference[1], &S2, &C2);
+    out.singularity = Singularity::elbow;
+  } else {
     C2 = (rho * X + z * Y) / D;
     S2 = (z * X - rho * Y) / D;
-    out.q[1] = std::atan2(S2, C2);
-  } else {  // wrist centre on the shoulder (only when a2 = forearm length)
-    out.q[1] = reference[1];
-    ::sincos(out.q[1], &S2, &C2);
-    out.singularity = Singularity::elbow;
   }
+  y[1] = S2;
+  x[1] = C2;
 
   // Joints 4-6 from R36 = R03^T R: a36 = (-C4 S5, -S4 S5, C5), n36_z = S5 C6, o36_z = -S5 S6.
   const double S23 = S2 * C3 + C2 * S3, C23 = C2 * C3 - S2 * S3;
@@ -157,19 +163,38 @@ IkStatus PumaKinematics::solve(const math::Transform& pose, Configuration which,
   const math::Vec3& o = pose.R.o;
   const math::Vec3& a = pose.R.a;
   const double r02 = math::dot(c0, a), r12 = math::dot(c1, a), r22 = math::dot(c2, a);
-  const double r20 = math::dot(c2, n), r21 = math::dot(c2, o);
   const double wrist = flip ? -1.0 : 1.0;  // sign of S5
-  const double S5 = wrist * std::hypot(r02, r12);
-  out.q[4] = std::atan2(S5, r22);
-  if (S5 * wrist > kSingular) {
-    out.q[3] = std::atan2(-wrist * r12, -wrist * r02);
-    out.q[5] = std::atan2(-wrist * r21, wrist * r20);
-  } else {  // theta5 = 0 or pi: joints 4 and 6 aligned, keep the reference theta4
-    out.q[3] = reference[3];
+  const double abs_s5 = std::sqrt(r02 * r02 + r12 * r12);
+  y[3] = wrist * abs_s5;
+  x[3] = r22;
+  const bool wrist_free = !(abs_s5 > kSingular);  // theta5 = 0 or pi: joints 4 and 6 aligned
+  if (wrist_free) {
+    // Only theta4 +- theta6 is determined: keep the reference theta4.
     const double r00 = math::dot(c0, n), r10 = math::dot(c1, n);
-    out.q[5] = r22 > 0.0 ? std::atan2(r10, r00) - out.q[3] : out.q[3] + std::atan2(r10, -r00);
-    out.q[5] = std::remainder(out.q[5], 2.0 * math::kPi);
+    y[5] = r10;
+    x[5] = r22 > 0.0 ? r00 : -r00;
     out.singularity = Singularity::wrist;
+  } else {
+    y[4] = -wrist * r12;
+    x[4] = -wrist * r02;
+    y[5] = -wrist * math::dot(c2, o);
+    x[5] = wrist * math::dot(c2, n);
+  }
+
+  double angle[8];
+  math::atan2_4(y, x, angle);
+  math::atan2_4(y + 4, x + 4, angle + 4);
+  out.q[0] = shoulder_free ? reference[0] : angle[0];
+  out.q[1] = elbow_free ? reference[1] : angle[1];
+  out.q[2] = angle[2];
+  out.q[4] = angle[3];
+  if (wrist_free) {
+    out.q[3] = reference[3];
+    out.q[5] =
+        std::remainder(r22 > 0.0 ? angle[5] - out.q[3] : angle[5] + out.q[3], 2.0 * math::kPi);
+  } else {
+    out.q[3] = angle[4];
+    out.q[5] = angle[5];
   }
   return IkStatus::ok;
 }

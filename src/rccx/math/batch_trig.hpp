@@ -1,0 +1,25 @@
+// Four sines and cosines, or four atan2, in one call. The closed-form kinematics need several
+// of each per solution with no dependency between them, so they are computed side by side:
+// with SLEEF's AVX2 kernels (3.5 ulp at most) when the processor has AVX2 and FMA, with glibc
+// otherwise. The choice is made once, at run time, so one binary runs on any x86-64.
+#pragma once
+
+namespace rccx::math {
+
+/// s[i] = sin(angle_rad[i]), c[i] = cos(angle_rad[i]) for i = 0..3.
+void sincos4(const double angle_rad[4], double s[4], double c[4]) noexcept;
+/// out_rad[i] = atan2(y[i], x[i]) for i = 0..3, in [-pi, pi].
+void atan2_4(const double y[4], const double x[4], double out_rad[4]) noexcept;
+
+/// Whether the AVX2 kernels are in use on this processor.
+bool batch_trig_uses_avx2() noexcept;
+
+namespace detail {
+// The two implementations, exposed for the tests that compare them.
+void sincos4_scalar(const double angle_rad[4], double s[4], double c[4]) noexcept;
+void atan2_4_scalar(const double y[4], const double x[4], double out_rad[4]) noexcept;
+void sincos4_avx2(const double angle_rad[4], double s[4], double c[4]) noexcept;
+void atan2_4_avx2(const double y[4], const double x[4], double out_rad[4]) noexcept;
+}  // namespace detail
+
+}  // namespace rccx::math

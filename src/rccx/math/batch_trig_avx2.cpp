@@ -1,0 +1,19 @@
+// Compiled with -mavx2 -mfma (src/CMakeLists.txt); called only when the processor has both.
+#include <immintrin.h>
+#include <sleef.h>
+
+#include "rccx/math/batch_trig.hpp"
+
+namespace rccx::math::detail {
+
+void sincos4_avx2(const double angle_rad[4], double s[4], double c[4]) noexcept {
+  const Sleef___m256d_2 r = Sleef_sincosd4_u35avx2(_mm256_loadu_pd(angle_rad));
+  _mm256_storeu_pd(s, r.x);
+  _mm256_storeu_pd(c, r.y);
+}
+
+void atan2_4_avx2(const double y[4], const double x[4], double out_rad[4]) noexcept {
+  _mm256_storeu_pd(out_rad, Sleef_atan2d4_u35avx2(_mm256_loadu_pd(y), _mm256_loadu_pd(x)));
+}
+
+}  // namespace rccx::math::detail
