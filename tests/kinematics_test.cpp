@@ -7,6 +7,7 @@
 #include <kdl/chainjnttojacsolver.hpp>
 #include <map>
 #include <random>
+#include <tuple>
 
 #include "rccx/kinematics/dh_kinematics.hpp"
 #include "rccx/kinematics/kinematics.hpp"
@@ -341,6 +342,29 @@ TEST(Puma560, JointRangesBeyondATurnFollowNear) {
   const kin::IkResult r2 = k->inverse(k->forward(q), options);
   ASSERT_TRUE(r2);
   EXPECT_NEAR(r2.q[5], 250_deg - 360_deg, 1e-12);
+}
+
+TEST(Puma560, LimitsAwayFromZeroAreReachedByWholeTurns) {
+  kin::RobotModel m = kin::builtin_robot("puma560");
+  for (const auto& [lower, upper, value] : {std::tuple{190.0, 330.0, 250.0},     // one turn up
+                                            std::tuple{-330.0, -190.0, -250.0},  // one turn down
+                                            std::tuple{600.0, 700.0, 650.0}}) {  // two turns
+    m.joints[0].lower = math::deg_to_rad(lower);
+    m.joints[0].upper = math::deg_to_rad(upper);
+    m.joints[0].ready = math::deg_to_rad(value);
+    const auto k = kin::make_kinematics(m);
+    const kin::JointVector q{math::deg_to_rad(value), 0.6, -2.2, 0.4, 0.8, 0.3};
+    kin::IkOptions options;
+    options.configuration = k->configuration_of(q);
+    const kin::IkResult r = k->inverse(k->forward(q), options);
+    ASSERT_TRUE(r) << kin::describe(r.status) << " for theta1 = " << value;
+    EXPECT_NEAR(r.q[0], q[0], 1e-9) << value;
+    // Half a turn further the same pose is out of joint 1's limits.
+    m.joints[0].ready = m.joints[0].lower;
+    const auto k2 = kin::make_kinematics(m);
+    const kin::JointVector q2{math::deg_to_rad(value + 180.0), 0.6, -2.2, 0.4, 0.8, 0.3};
+    EXPECT_EQ(k2->inverse(k2->forward(q2), options).status, kin::IkStatus::joint_limits) << value;
+  }
 }
 
 TEST(Puma560, AskedConfigurationOutsideLimitsIsSaid) {

@@ -1,6 +1,7 @@
 #include "rccx/kinematics/kinematics.hpp"
 
 #include <cmath>
+#include <cstdint>
 #include <limits>
 
 #include "rccx/kinematics/dh_kinematics.hpp"
@@ -104,38 +105,51 @@ const JointVector* Kinematics::reference_pose(const IkOptions& options) const no
   return &*options.near;
 }
 
+namespace {
+
+// floor and ceil of a count of turns, inline: without SSE4.1 std::floor and std::ceil are
+// library calls, and they were most of the cost of fitting a solution to the limits. Counts
+// beyond +-1e9 turns are clamped (no joint has that range).
+double floor_turns(double x) noexcept {
+  const double t = std::clamp(x, -1e9, 1e9);
+  const auto i = static_cast<std::int64_t>(t);
+  return static_cast<double>(i - (t < static_cast<double>(i) ? 1 : 0));
+}
+
+double ceil_turns(double x) noexcept {
+  const double t = std::clamp(x, -1e9, 1e9);
+  const auto i = static_cast<std::int64_t>(t);
+  return static_cast<double>(i + (t > static_cast<double>(i) ? 1 : 0));
+}
+
+}  // namespace
+
 bool Kinematics::fit_to_limits(JointVector& q, const JointVector& toward) const noexcept {
   constexpr double kTurn = 2.0 * math::kPi;
   constexpr double kInvTurn = 1.0 / kTurn;
+  bool within = true;
   for (std::size_t i = 0; i < dof(); ++i) {
     const Limit& l = limits_[i];
     double v = q[i];
-    // Less than a turn of range: a value within limits has no other turn within them.
-    if (!l.multi_turn && v >= l.lo && v <= l.hi) {
-      q[i] = std::clamp(v, l.lower, l.upper);
-      continue;
-    }
-    if (l.revolute) {
-      if (!l.multi_turn) {
-        // Raw IK angles are in (-pi, pi], so one turn either way is the only candidate; the
-        // general case below still covers other inputs.
-        const double w = v < l.lo ? v + kTurn : v - kTurn;
-        if (w >= l.lo && w <= l.hi) {
-          q[i] = std::clamp(w, l.lower, l.upper);
-          continue;
-        }
-      }
+    if (l.multi_turn) {
       // Whole turns that bring v within limits: k_lo..k_hi; the one nearest `toward` wins.
-      const double k_lo = std::ceil((l.lo - v) * kInvTurn);
-      const double k_hi = std::floor((l.hi - v) * kInvTurn);
-      if (k_lo > k_hi) return false;
-      const double k_near = std::nearbyint((toward[i] - v) * kInvTurn);
-      v += kTurn * std::clamp(k_near, k_lo, k_hi);
+      const double k_lo = ceil_turns((l.lo - v) * kInvTurn);
+      const double k_hi = floor_turns((l.hi - v) * kInvTurn);
+      const double k_near = floor_turns((toward[i] - v) * kInvTurn + 0.5);
+      v += kTurn * std::min(std::max(k_near, k_lo), k_hi);  // out of limits when k_lo > k_hi
+    } else if (l.revolute) {
+      // Less than a turn of range: at most one turn puts v within limits. Written without
+      // branches: whether a raw angle needs the turn is a coin toss the predictor would lose.
+      v += kTurn * (static_cast<double>(v < l.lo) - static_cast<double>(v > l.hi));
+      if (!(v >= l.lo && v <= l.hi)) {  // a limit beyond one turn of (-pi, pi]: the long way
+        const double k_lo = ceil_turns((l.lo - q[i]) * kInvTurn);
+        v = q[i] + kTurn * k_lo;
+      }
     }
-    if (!(v >= l.lo && v <= l.hi)) return false;
-    q[i] = std::clamp(v, l.lower, l.upper);
+    within = within && v >= l.lo && v <= l.hi;
+    q[i] = std::min(std::max(v, l.lower), l.upper);
   }
-  return true;
+  return within;
 }
 
 namespace {

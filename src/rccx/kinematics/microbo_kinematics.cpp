@@ -101,8 +101,9 @@ IkStatus MicroboKinematics::solve(const math::Transform& pose, Configuration whi
   if (shoulder_free) {
     ::sincos(reference[0], &S1, &C1);
   } else {
-    S1 = p.y / d3;
-    C1 = p.x / d3;
+    const double inv_d3 = 1.0 / d3;
+    S1 = p.y * inv_d3;
+    C1 = p.x * inv_d3;
   }
   y[0] = S1;
   x[0] = C1;
@@ -112,26 +113,31 @@ IkStatus MicroboKinematics::solve(const math::Transform& pose, Configuration whi
   // Joint 4 from the third column of U4: (C4 S5, S4 S5) = (a_y C1 - a_x S1, a_z).
   const double c4s5 = a.y * C1 - a.x * S1;
   const double s4s5 = a.z;
-  const double abs_s5 = std::sqrt(c4s5 * c4s5 + s4s5 * s4s5);
-  const double S5 = which.index == 0 ? -abs_s5 : abs_s5;
-  const bool wrist_free = !(abs_s5 > kSingular);  // theta5 = -pi: joints 4 and 6 aligned
-  double S4, C4;
-  if (wrist_free) {
-    ::sincos(reference[3], &S4, &C4);
-  } else {
-    S4 = s4s5 / S5;
-    C4 = c4s5 / S5;
-  }
-  y[1] = S4;
-  x[1] = C4;
-  // Joint 5 from U5 (erratum: a_y S1 + a_x C1).
-  y[2] = S5;
-  x[2] = -(a.y * S1 + a.x * C1);
-  // Joint 6 from the second column of U6.
+  const double s5_squared = c4s5 * c4s5 + s4s5 * s4s5;
+  const double sign = which.index == 0 ? -1.0 : 1.0;  // of S5
+  const double S5 = sign * std::sqrt(s5_squared);
+  const double C5 = -(a.y * S1 + a.x * C1);  // U5 (erratum: a_y S1 + a_x C1)
   const double oxy = o.y * S1 + C1 * o.x;
   const double oyx = C1 * o.y - o.x * S1;
-  y[3] = -(oxy * S5 + x[2] * (o.z * S4 + C4 * oyx));
-  x[3] = oyx * S4 - C4 * o.z;
+  const bool wrist_free = !(s5_squared > kSingular * kSingular);  // theta5 = -pi: 4, 6 aligned
+  if (wrist_free) {
+    double S4, C4;
+    ::sincos(reference[3], &S4, &C4);
+    y[1] = S4;
+    x[1] = C4;
+    // Joint 6 from the second column of U6.
+    y[3] = -(oxy * S5 + C5 * (o.z * S4 + C4 * oyx));
+    x[3] = oyx * S4 - C4 * o.z;
+  } else {
+    // The same with S4 and C4 scaled by |S5| (atan2 ignores a positive factor): no division
+    // on the way to the atan2.
+    y[1] = sign * s4s5;
+    x[1] = sign * c4s5;
+    y[3] = -sign * (oxy * s5_squared + C5 * (o.z * s4s5 + oyx * c4s5));
+    x[3] = sign * (oyx * s4s5 - o.z * c4s5);
+  }
+  y[2] = S5;
+  x[2] = C5;
 
   double angle[4];
   math::atan2_4(y, x, angle);

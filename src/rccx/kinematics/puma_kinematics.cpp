@@ -124,8 +124,9 @@ IkStatus PumaKinematics::solve(const math::Transform& pose, Configuration which,
     ::sincos(reference[0], &S1, &C1);
     out.singularity = Singularity::shoulder;
   } else {
-    C1 = (rho * w.x - d3_ * w.y) / r2;
-    S1 = (d3_ * w.x + rho * w.y) / r2;
+    const double inv_r2 = 1.0 / r2;
+    C1 = (rho * w.x - d3_ * w.y) * inv_r2;
+    S1 = (d3_ * w.x + rho * w.y) * inv_r2;
   }
   y[0] = S1;
   x[0] = C1;
@@ -148,8 +149,9 @@ IkStatus PumaKinematics::solve(const math::Transform& pose, Configuration which,
     ::sincos(reference[1], &S2, &C2);
     out.singularity = Singularity::elbow;
   } else {
-    C2 = (rho * X + z * Y) / D;
-    S2 = (z * X - rho * Y) / D;
+    const double inv_d = 1.0 / D;
+    C2 = (rho * X + z * Y) * inv_d;
+    S2 = (z * X - rho * Y) * inv_d;
   }
   y[1] = S2;
   x[1] = C2;
