@@ -7,6 +7,7 @@
 #include "rccx/kinematics/dh_kinematics.hpp"
 #include "rccx/kinematics/microbo_kinematics.hpp"
 #include "rccx/kinematics/puma_kinematics.hpp"
+#include "rccx/math/batch_trig.hpp"
 #include "rccx/math/units.hpp"
 
 namespace rccx::kin {
@@ -249,17 +250,25 @@ IkSolutions AnalyticKinematics::inverse_all(const math::Transform& pose,
 
 math::Transform Kinematics::chain_forward(const JointVector& q,
                                           math::Transform* frames) const noexcept {
+  // All the joint angles' sines and cosines first, four at a time.
+  double theta[kMaxJoints] = {}, st[kMaxJoints], ct[kMaxJoints];
+  for (std::size_t i = 0; i < dof(); ++i) {
+    theta[i] = links_[i].theta + (links_[i].prismatic ? 0.0 : q[i]);
+  }
+  math::sincos4(theta, st, ct);
+  if (dof() > 4) math::sincos4(theta + 4, st + 4, ct + 4);
   math::Transform T;
   for (std::size_t i = 0; i < dof(); ++i) {
     const Link& l = links_[i];
-    const double theta = l.theta + (l.prismatic ? 0.0 : q[i]);
     const double d = l.d + (l.prismatic ? q[i] : 0.0);
-    const double ct = std::cos(theta), st = std::sin(theta);
-    // Thesis eq. 3.3, by columns n, o, a, p.
-    const math::Transform A{
-        {{ct, st, 0}, {-st * l.ca, ct * l.ca, l.sa}, {st * l.sa, -ct * l.sa, l.ca}},
-        {l.a * ct, l.a * st, d}};
-    T = T * A;
+    // T A_i with A_i of thesis eq. 3.3 multiplied out: its n is (ct, st, 0), its o and a mix
+    // v = T.o ct - T.n st with T.a through alpha.
+    const math::Vec3 n = T.R.n * ct[i] + T.R.o * st[i];
+    const math::Vec3 v = T.R.o * ct[i] - T.R.n * st[i];
+    const math::Vec3 o = v * l.ca + T.R.a * l.sa;
+    const math::Vec3 a = T.R.a * l.ca - v * l.sa;
+    T.p += T.R.a * d + n * l.a;
+    T.R = {n, o, a};
     if (frames != nullptr) frames[i] = T;
   }
   return T;
