@@ -252,7 +252,26 @@ TEST(BatchTrig, BothImplementationsAgreeWithGlibc) {
   double out[4];
   atan2_4(y, x, out);
   EXPECT_EQ(out[0], 0.0);
-  EXPECT_EQ(out[2], kPi);
+  EXPECT_NEAR(out[2], kPi, 1e-15);
+  // The eight-wide calls agree with two four-wide ones.
+  double angles8[8], y8[8], x8[8];
+  for (int i = 0; i < 8; ++i) {
+    angles8[i] = 0.7 * i - 2.0;
+    y8[i] = std::sin(0.3 * i);
+    x8[i] = std::cos(1.1 * i);
+  }
+  double s8[8], c8[8], a8[8], s4[4], c4[4], a4[4];
+  sincos8(angles8, s8, c8);
+  atan2_8(y8, x8, a8);
+  for (int half = 0; half < 2; ++half) {
+    sincos4(angles8 + 4 * half, s4, c4);
+    atan2_4(y8 + 4 * half, x8 + 4 * half, a4);
+    for (int i = 0; i < 4; ++i) {
+      EXPECT_EQ(s8[4 * half + i], s4[i]);
+      EXPECT_EQ(c8[4 * half + i], c4[i]);
+      EXPECT_EQ(a8[4 * half + i], a4[i]);
+    }
+  }
 }
 
 }  // namespace

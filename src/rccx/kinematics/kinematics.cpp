@@ -255,8 +255,11 @@ math::Transform Kinematics::chain_forward(const JointVector& q,
   for (std::size_t i = 0; i < dof(); ++i) {
     theta[i] = links_[i].theta + (links_[i].prismatic ? 0.0 : q[i]);
   }
-  math::sincos4(theta, st, ct);
-  if (dof() > 4) math::sincos4(theta + 4, st + 4, ct + 4);
+  if (dof() > 4) {
+    math::sincos8(theta, st, ct);
+  } else {
+    math::sincos4(theta, st, ct);
+  }
   math::Transform T;
   for (std::size_t i = 0; i < dof(); ++i) {
     const Link& l = links_[i];

@@ -70,11 +70,9 @@ Configuration PumaKinematics::configuration_of(const JointVector& q) const noexc
 }
 
 math::Transform PumaKinematics::forward(const JointVector& q) const noexcept {
-  const double first[4] = {q[0], q[1], q[3], q[4]};
-  const double second[4] = {q[5], q[1] + q[2], 0.0, 0.0};
+  const double angles[8] = {q[0], q[1], q[3], q[4], q[5], q[1] + q[2], 0.0, 0.0};
   double s[8], c[8];
-  math::sincos4(first, s, c);
-  math::sincos4(second, s + 4, c + 4);
+  math::sincos8(angles, s, c);
   const double S1 = s[0], C1 = c[0], S2 = s[1], C2 = c[1], S4 = s[2], C4 = c[2], S5 = s[3],
                C5 = c[3], S6 = s[4], C6 = c[4], S23 = s[5], C23 = c[5];
   // R03 by columns, and R36 = R4 R5 R6 by columns.
@@ -184,8 +182,7 @@ IkStatus PumaKinematics::solve(const math::Transform& pose, Configuration which,
   }
 
   double angle[8];
-  math::atan2_4(y, x, angle);
-  math::atan2_4(y + 4, x + 4, angle + 4);
+  math::atan2_8(y, x, angle);
   out.q[0] = shoulder_free ? reference[0] : angle[0];
   out.q[1] = elbow_free ? reference[1] : angle[1];
   out.q[2] = angle[2];

@@ -41,4 +41,22 @@ void atan2_4(const double y[4], const double x[4], double out_rad[4]) noexcept {
   }
 }
 
+void sincos8(const double angle_rad[8], double s[8], double c[8]) noexcept {
+  if (kUseAvx2) {
+    detail::sincos8_avx2(angle_rad, s, c);
+  } else {
+    detail::sincos4_scalar(angle_rad, s, c);
+    detail::sincos4_scalar(angle_rad + 4, s + 4, c + 4);
+  }
+}
+
+void atan2_8(const double y[8], const double x[8], double out_rad[8]) noexcept {
+  if (kUseAvx2) {
+    detail::atan2_8_avx2(y, x, out_rad);
+  } else {
+    detail::atan2_4_scalar(y, x, out_rad);
+    detail::atan2_4_scalar(y + 4, x + 4, out_rad + 4);
+  }
+}
+
 }  // namespace rccx::math

@@ -24,4 +24,20 @@ void atan2_4_avx2(const double y[4], const double x[4], double out_rad[4]) noexc
   _mm256_storeu_pd(out_rad, Sleef_atan2d4_u35avx2(gather(y), gather(x)));
 }
 
+void sincos8_avx2(const double angle_rad[8], double s[8], double c[8]) noexcept {
+  const Sleef___m256d_2 low = Sleef_sincosd4_u35avx2(gather(angle_rad));
+  const Sleef___m256d_2 high = Sleef_sincosd4_u35avx2(gather(angle_rad + 4));
+  _mm256_storeu_pd(s, low.x);
+  _mm256_storeu_pd(c, low.y);
+  _mm256_storeu_pd(s + 4, high.x);
+  _mm256_storeu_pd(c + 4, high.y);
+}
+
+void atan2_8_avx2(const double y[8], const double x[8], double out_rad[8]) noexcept {
+  const __m256d low = Sleef_atan2d4_u35avx2(gather(y), gather(x));
+  const __m256d high = Sleef_atan2d4_u35avx2(gather(y + 4), gather(x + 4));
+  _mm256_storeu_pd(out_rad, low);
+  _mm256_storeu_pd(out_rad + 4, high);
+}
+
 }  // namespace rccx::math::detail
