@@ -52,9 +52,17 @@ int main() {
     }
   }
 
-  // The PUMA 560: the same pose in all eight configurations.
-  const auto puma = kin::make_kinematics(kin::builtin_robot("puma560"));
-  const kin::JointVector q0{0.3, 0.7, -2.6, 0.4, 0.9, -0.5};
+  // The PUMA 560: the same pose in all eight configurations. A copy of the model without joint
+  // limits tells which joint keeps a configuration out of reach.
+  const kin::RobotModel puma_model = kin::builtin_robot("puma560");
+  const auto puma = kin::make_kinematics(puma_model);
+  kin::RobotModel unlimited = puma_model;
+  for (kin::Joint& j : unlimited.joints) {
+    j.lower = -4 * math::kPi;
+    j.upper = 4 * math::kPi;
+  }
+  const auto puma_unlimited = kin::make_kinematics(unlimited);
+  const kin::JointVector q0{-0.8, 0.7, -2.6, 0.4, 0.9, -0.5};
   const math::Transform T = puma->forward(q0);
   fmt::print("\n{} - one pose, every configuration (from q = ", puma->model().title);
   print_joints(*puma, q0);
@@ -65,9 +73,18 @@ int main() {
     fmt::print("  {}:", name);
     if (r) {
       print_joints(*puma, r.q);
-    } else {
-      fmt::print(" {}\n", kin::describe(r.status));
+      continue;
     }
+    const kin::IkResult free = puma_unlimited->inverse(T, options);
+    const int j = free ? puma_model.first_joint_outside_limits(free.q) : -1;
+    if (j < 0) {
+      fmt::print(" {}\n", kin::describe(r.status));
+      continue;
+    }
+    const kin::Joint& joint = puma_model.joints[static_cast<std::size_t>(j)];
+    fmt::print(" needs {} = {:.1f} deg, outside its limits {:.0f} .. {:.0f} deg\n", joint.name,
+               math::rad_to_deg(free.q[static_cast<std::size_t>(j)]), math::rad_to_deg(joint.lower),
+               math::rad_to_deg(joint.upper));
   }
 
   // A pose beyond the arm's reach gives a reason, not NaN.
