@@ -132,6 +132,12 @@ bool Kinematics::fit_to_limits(JointVector& q, const JointVector& toward) const 
   for (std::size_t i = 0; i < dof(); ++i) {
     const Limit& l = limits_[i];
     double v = q[i];
+    // The usual case, kept short: v within limits, and no other turn nearer `toward` (a joint
+    // with less than a turn of range has no other turn within limits at all).
+    if (v >= l.lo && v <= l.hi && (!l.multi_turn || std::abs(toward[i] - v) <= math::kPi)) {
+      q[i] = std::min(std::max(v, l.lower), l.upper);
+      continue;
+    }
     if (l.multi_turn) {
       // Whole turns that bring v within limits: k_lo..k_hi; the one nearest `toward` wins.
       const double k_lo = ceil_turns((l.lo - v) * kInvTurn);
@@ -139,13 +145,10 @@ bool Kinematics::fit_to_limits(JointVector& q, const JointVector& toward) const 
       const double k_near = floor_turns((toward[i] - v) * kInvTurn + 0.5);
       v += kTurn * std::min(std::max(k_near, k_lo), k_hi);  // out of limits when k_lo > k_hi
     } else if (l.revolute) {
-      // Less than a turn of range: at most one turn puts v within limits. Written without
-      // branches: whether a raw angle needs the turn is a coin toss the predictor would lose.
-      v += kTurn * (static_cast<double>(v < l.lo) - static_cast<double>(v > l.hi));
-      if (!(v >= l.lo && v <= l.hi)) {  // a limit beyond one turn of (-pi, pi]: the long way
-        const double k_lo = ceil_turns((l.lo - q[i]) * kInvTurn);
-        v = q[i] + kTurn * k_lo;
-      }
+      // At most one turn puts v within limits; raw angles in (-pi, pi] need one at most, other
+      // values the long way.
+      v += v < l.lo ? kTurn : -kTurn;
+      if (!(v >= l.lo && v <= l.hi)) v = q[i] + kTurn * ceil_turns((l.lo - q[i]) * kInvTurn);
     }
     within = within && v >= l.lo && v <= l.hi;
     q[i] = std::min(std::max(v, l.lower), l.upper);
