@@ -1,6 +1,7 @@
 #include "rccx/kinematics/dh_kinematics.hpp"
 
 #include <Eigen/Cholesky>
+#include <array>
 #include <cmath>
 
 namespace rccx::kin {
@@ -27,7 +28,8 @@ IkResult DhKinematics::inverse(const math::Transform& pose,
   result.status = IkStatus::no_convergence;
 
   for (int iteration = 0; iteration < settings_.max_iterations; ++iteration) {
-    const math::Transform T = chain_forward(q);
+    std::array<math::Transform, kMaxJoints> frames;
+    const math::Transform T = chain_forward(q, frames.data());
     const math::Vec3 dp = pose.p - T.p;
     // Orientation error as a rotation vector, in the base frame: R_target R^T.
     math::Vec3 axis;
@@ -41,7 +43,7 @@ IkResult DhKinematics::inverse(const math::Transform& pose,
     const math::Vec3 dw = axis * angle;
     Eigen::Matrix<double, 6, 1> e;
     e << dp.x, dp.y, dp.z, dw.x, dw.y, dw.z;
-    const Jacobian J = jacobian(q);
+    const Jacobian J = jacobian_from_frames(frames.data());
     Eigen::Matrix<double, 6, 6> JJt = J * J.transpose();
     JJt.diagonal().array() += lambda2;
     const Eigen::Matrix<double, 6, 1> y = JJt.ldlt().solve(e);

@@ -282,13 +282,18 @@ math::Transform Kinematics::chain_forward(const JointVector& q,
 
 Jacobian Kinematics::jacobian(const JointVector& q) const noexcept {
   std::array<math::Transform, kMaxJoints> frames;
-  const math::Transform T6 = chain_forward(q, frames.data());
+  chain_forward(q, frames.data());
+  return jacobian_from_frames(frames.data());
+}
+
+Jacobian Kinematics::jacobian_from_frames(const math::Transform* frames) const noexcept {
+  const math::Vec3& tip = frames[dof() - 1].p;
   Jacobian J(6, static_cast<Eigen::Index>(dof()));
   for (std::size_t i = 0; i < dof(); ++i) {
     // Joint i+1 moves about / along z of frame i (the base frame for the first joint).
     const math::Vec3 z = i == 0 ? math::Vec3{0, 0, 1} : frames[i - 1].R.a;
     const math::Vec3 origin = i == 0 ? math::Vec3{} : frames[i - 1].p;
-    const math::Vec3 v = links_[i].prismatic ? z : math::cross(z, T6.p - origin);
+    const math::Vec3 v = links_[i].prismatic ? z : math::cross(z, tip - origin);
     const math::Vec3 w = links_[i].prismatic ? math::Vec3{} : z;
     const auto col = static_cast<Eigen::Index>(i);
     J.col(col) << v.x, v.y, v.z, w.x, w.y, w.z;

@@ -134,6 +134,9 @@ class Kinematics {
   math::Transform chain_forward(const JointVector& q,
                                 math::Transform* frames = nullptr) const noexcept;
 
+  /// The geometric Jacobian from the link frames chain_forward filled (frames[dof() - 1] = T6).
+  Jacobian jacobian_from_frames(const math::Transform* frames) const noexcept;
+
   /// Cached per-link constants of the DH chain.
   struct Link {
     double a, ca, sa, d, theta;
