@@ -41,7 +41,8 @@ std::string_view describe(IkStatus status) noexcept {
     case IkStatus::joint_limits:
       return "out of joint limits: the pose is reachable only with a joint outside its limits";
     case IkStatus::singular:
-      return "singular: the Jacobian lost rank and the numeric solver could not leave it";
+      return "stuck: a joint limit or a singularity blocks every step of the numeric solver (try "
+             "another --near)";
     case IkStatus::no_convergence:
       return "no convergence: the numeric solver did not reach the pose (unreachable, or try "
              "another --near)";
