@@ -96,45 +96,45 @@ IkStatus MicroboKinematics::solve(const math::Transform& pose, Configuration whi
 
   // Joints 1-3 from p (eq. 3.14); d3 is the positive root by the robot's geometry.
   const double d3 = std::sqrt(p.x * p.x + p.y * p.y);
+  out.q[1] = p.z;
+  out.q[2] = d3;
+  // Below, S1 and C1 enter scaled by d3 (they are p_y / d3 and p_x / d3) so that no division
+  // stands between the pose and the atan2; every sine-cosine pair an angle comes from is then
+  // scaled by a positive factor, which atan2 ignores.
   const bool shoulder_free = !(d3 > kSingular);  // wrist on joint 1's axis: any theta1 will do
-  double S1, C1;
+  double S1 = p.y, C1 = p.x, scale = d3;
   if (shoulder_free) {
     ::sincos(reference[0], &S1, &C1);
-  } else {
-    const double inv_d3 = 1.0 / d3;
-    S1 = p.y * inv_d3;
-    C1 = p.x * inv_d3;
+    scale = 1.0;
   }
   y[0] = S1;
   x[0] = C1;
-  out.q[1] = p.z;
-  out.q[2] = d3;
 
   // Joint 4 from the third column of U4: (C4 S5, S4 S5) = (a_y C1 - a_x S1, a_z).
   const double c4s5 = a.y * C1 - a.x * S1;
-  const double s4s5 = a.z;
+  const double s4s5 = a.z * scale;
   const double s5_squared = c4s5 * c4s5 + s4s5 * s4s5;
   const double sign = which.index == 0 ? -1.0 : 1.0;  // of S5
   const double S5 = sign * std::sqrt(s5_squared);
   const double C5 = -(a.y * S1 + a.x * C1);  // U5 (erratum: a_y S1 + a_x C1)
   const double oxy = o.y * S1 + C1 * o.x;
   const double oyx = C1 * o.y - o.x * S1;
-  const bool wrist_free = !(s5_squared > kSingular * kSingular);  // theta5 = -pi: 4, 6 aligned
-  if (wrist_free) {
+  const double oz = o.z * scale;
+  const bool wrist_free = !(s5_squared > kSingular * kSingular * scale * scale);
+  if (wrist_free) {  // theta5 = -pi: joints 4 and 6 aligned, keep the reference theta4
     double S4, C4;
     ::sincos(reference[3], &S4, &C4);
     y[1] = S4;
     x[1] = C4;
-    // Joint 6 from the second column of U6.
-    y[3] = -(oxy * S5 + C5 * (o.z * S4 + C4 * oyx));
-    x[3] = oyx * S4 - C4 * o.z;
+    // Joint 6 from the second column of U6 (both sides scaled by scale^2).
+    y[3] = -(oxy * S5 + C5 * (oz * S4 + C4 * oyx));
+    x[3] = scale * (oyx * S4 - C4 * oz);
   } else {
-    // The same with S4 and C4 scaled by |S5| (atan2 ignores a positive factor): no division
-    // on the way to the atan2.
+    // The same with S4 and C4 scaled by |S5| as well (both sides by scale^3 |S5|).
     y[1] = sign * s4s5;
     x[1] = sign * c4s5;
-    y[3] = -sign * (oxy * s5_squared + C5 * (o.z * s4s5 + oyx * c4s5));
-    x[3] = sign * (oyx * s4s5 - o.z * c4s5);
+    y[3] = -sign * (oxy * s5_squared + C5 * (oz * s4s5 + oyx * c4s5));
+    x[3] = sign * scale * (oyx * s4s5 - oz * c4s5);
   }
   y[2] = S5;
   x[2] = C5;
