@@ -16,14 +16,11 @@ math::Transform DhKinematics::forward(const JointVector& q) const noexcept {
 IkResult DhKinematics::inverse(const math::Transform& pose,
                                const IkOptions& options) const noexcept {
   IkResult result;
-  const JointVector* const reference = reference_pose(options);
+  const JointVector* const reference = checked_reference(pose, options);
   if (reference == nullptr) return result;  // bad_input
-  for (double v : pose.rows()) {
-    if (!std::isfinite(v)) return result;
-  }
+  const std::vector<Joint>& joints = model().joints;
   JointVector q = *reference;
-  const JointVector lower = model().lower(), upper = model().upper();
-  for (std::size_t i = 0; i < dof(); ++i) q[i] = std::clamp(q[i], lower[i], upper[i]);
+  for (std::size_t i = 0; i < dof(); ++i) q[i] = std::clamp(q[i], joints[i].lower, joints[i].upper);
   const double lambda2 = settings_.damping * settings_.damping;
   result.status = IkStatus::no_convergence;
 
@@ -56,7 +53,8 @@ IkResult DhKinematics::inverse(const math::Transform& pose,
     if (largest > settings_.max_step_rad_or_m) dq *= settings_.max_step_rad_or_m / largest;
     bool moved = false;
     for (std::size_t i = 0; i < dof(); ++i) {
-      const double next = std::clamp(q[i] + dq(static_cast<Eigen::Index>(i)), lower[i], upper[i]);
+      const double next =
+          std::clamp(q[i] + dq(static_cast<Eigen::Index>(i)), joints[i].lower, joints[i].upper);
       moved = moved || next != q[i];
       q[i] = next;
     }

@@ -98,7 +98,11 @@ std::string_view Kinematics::configuration_name(Configuration c) const noexcept 
   return c.index < names.size() ? names[c.index] : std::string_view{};
 }
 
-const JointVector* Kinematics::reference_pose(const IkOptions& options) const noexcept {
+const JointVector* Kinematics::checked_reference(const math::Transform& pose,
+                                                 const IkOptions& options) const noexcept {
+  for (double v : pose.rows()) {
+    if (!std::isfinite(v)) return nullptr;
+  }
   if (!options.near) return &ready_;
   if (options.near->size() != dof()) return nullptr;
   for (double v : *options.near) {
@@ -159,13 +163,6 @@ bool Kinematics::fit_to_limits(JointVector& q, const JointVector& toward) const 
 
 namespace {
 
-bool finite_pose(const math::Transform& pose) noexcept {
-  for (double v : pose.rows()) {
-    if (!std::isfinite(v)) return false;
-  }
-  return true;
-}
-
 double squared_distance(const JointVector& a, const JointVector& b) noexcept {
   double s = 0.0;
   for (std::size_t i = 0; i < a.size(); ++i) s += (a[i] - b[i]) * (a[i] - b[i]);
@@ -190,11 +187,10 @@ IkSolutions Kinematics::inverse_all(const math::Transform& pose,
 IkResult AnalyticKinematics::inverse(const math::Transform& pose,
                                      const IkOptions& options) const noexcept {
   IkResult best;
-  const JointVector* const reference = reference_pose(options);
-  if (reference == nullptr || !finite_pose(pose)) return best;  // bad_input
-  const auto names = configuration_names();
   if (options.configuration) {
-    if (options.configuration->index >= names.size()) {
+    const JointVector* const reference = checked_reference(pose, options);
+    if (reference == nullptr) return best;  // bad_input
+    if (options.configuration->index >= configuration_names().size()) {
       best.status = IkStatus::bad_configuration;
       return best;
     }
@@ -202,24 +198,16 @@ IkResult AnalyticKinematics::inverse(const math::Transform& pose,
     if (best && !fit_to_limits(best.q, *reference)) best.status = IkStatus::joint_limits;
     return best;
   }
-  // Closest to the reference over all configurations.
+  // The solution closest to the reference among every configuration's.
+  const IkSolutions all = inverse_all(pose, options);
+  best.status = all.status;
+  const JointVector& reference = options.near ? *options.near : ready_pose();
   double best_distance = std::numeric_limits<double>::infinity();
-  best.status = IkStatus::out_of_reach;
-  for (std::size_t c = 0; c < names.size(); ++c) {
-    IkResult candidate;
-    if (solve(pose, Configuration{static_cast<std::uint8_t>(c)}, *reference, candidate) !=
-        IkStatus::ok) {
-      continue;
-    }
-    if (!fit_to_limits(candidate.q, *reference)) {
-      if (!best) best.status = IkStatus::joint_limits;
-      continue;
-    }
-    const double distance = squared_distance(candidate.q, *reference);
+  for (const IkResult& candidate : all.solutions()) {
+    const double distance = squared_distance(candidate.q, reference);
     if (distance < best_distance) {
       best_distance = distance;
       best = candidate;
-      best.status = IkStatus::ok;
     }
   }
   return best;
@@ -228,8 +216,8 @@ IkResult AnalyticKinematics::inverse(const math::Transform& pose,
 IkSolutions AnalyticKinematics::inverse_all(const math::Transform& pose,
                                             const IkOptions& options) const noexcept {
   IkSolutions all;
-  const JointVector* const reference = reference_pose(options);
-  if (reference == nullptr || !finite_pose(pose)) {
+  const JointVector* const reference = checked_reference(pose, options);
+  if (reference == nullptr) {
     all.status = IkStatus::bad_input;
     return all;
   }

@@ -125,9 +125,13 @@ class Kinematics {
   /// Moves each revolute joint of q by whole turns to the value within limits closest to
   /// `toward`, and checks prismatic ones. False when some joint cannot be brought within limits.
   bool fit_to_limits(JointVector& q, const JointVector& toward) const noexcept;
-  /// `near` when given, else the ready pose; nullptr when `near` has the wrong size or
-  /// non-finite values. Points into `options` or *this: nothing is copied.
-  const JointVector* reference_pose(const IkOptions& options) const noexcept;
+  /// The pose to stay near: `near` when given, else the ready pose. nullptr when the request
+  /// is bad input: a pose with a non-finite element, or `near` of the wrong size or non-finite.
+  /// Points into `options` or *this: nothing is copied.
+  const JointVector* checked_reference(const math::Transform& pose,
+                                       const IkOptions& options) const noexcept;
+  /// The model's ready pose, built once.
+  const JointVector& ready_pose() const noexcept { return ready_; }
 
   /// T6 by multiplying the DH chain's A matrices (thesis eq. 3.11); frames[i], when given,
   /// receives A1 ... A(i+1), the frame of link i+1.
