@@ -4,7 +4,9 @@ DEBUG_DIR := build/debug
 RELEASE_DIR := build/release
 CMAKE ?= cmake
 
-.PHONY: all deps demo test bench build-debug build-release format format-check clean
+TSAN_DIR := build/tsan
+
+.PHONY: all deps demo test tsan bench build-debug build-release format format-check clean
 
 all: build-release
 
@@ -23,13 +25,22 @@ build-debug: deps $(DEBUG_DIR)/CMakeCache.txt
 build-release: deps $(RELEASE_DIR)/CMakeCache.txt
 	$(CMAKE) --build $(RELEASE_DIR) -j$(JOBS)
 
-# The main example on simulated robots (for now: kinematics of the thesis's robots).
+# The main examples on simulated robots: kinematics of the thesis's robots, an RTC session.
 demo: build-release
 	$(RELEASE_DIR)/examples/01_kinematics
+	@echo
+	$(RELEASE_DIR)/examples/02_rtc_session
 
 # Debug build with AddressSanitizer and UndefinedBehaviorSanitizer, then every test.
 test: build-debug
 	cd $(DEBUG_DIR) && ctest --output-on-failure -j$(JOBS)
+
+# The threaded parts (RTC sessions) under ThreadSanitizer.
+tsan: deps
+	$(CMAKE) -S . -B $(TSAN_DIR) -DCMAKE_BUILD_TYPE=Debug -DRCCX_TSAN=ON -DRCCX_BUILD_BENCHMARKS=OFF
+	$(CMAKE) --build $(TSAN_DIR) -j$(JOBS) --target rccx_rtc_tests
+	cd $(TSAN_DIR) && TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1" \
+	  ctest -L rtc --output-on-failure -j$(JOBS)
 
 # Release benchmarks against Orocos KDL; JSON under bench-results/.
 bench: build-release

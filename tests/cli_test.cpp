@@ -3,10 +3,14 @@
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "rccx/kinematics/kinematics.hpp"
 
@@ -160,3 +164,114 @@ TEST(Cli, RobotsListsJointsAndLimits) {
 }
 
 }  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// The RTC control programs on simulated robots (simulated time: deterministic and fast).
+
+namespace {
+
+/// Runs rccx with `input` on its standard input.
+CliRun rccx_cli_with_input(const std::string& arguments, const std::string& input) {
+  char path[] = "/tmp/rccx_cli_input_XXXXXX";
+  const int fd = mkstemp(path);
+  if (fd < 0) return {};
+  FILE* f = fdopen(fd, "w");
+  std::fputs(input.c_str(), f);
+  std::fclose(f);
+  CliRun run = rccx_cli(arguments + " < " + path);
+  std::remove(path);
+  return run;
+}
+
+/// The value printed after "NAME " on the last line that has it (report's position lines).
+double last_value_of(const std::string& out, const std::string& name) {
+  const auto at = out.rfind(" " + name + " ");
+  if (at == std::string::npos) return std::nan("");
+  return std::stod(out.substr(at + name.size() + 2));
+}
+
+}  // namespace
+
+TEST(CliRtc, ReportPrintsPositionsInDegreesAndMillimetres) {
+  const CliRun run = rccx_cli("report --robot microbo --seconds 1 --every 0.25");
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  EXPECT_EQ(std::count(run.out.begin(), run.out.end(), '\n'), 4) << run.out;
+  const auto model = kin::builtin_robot("microbo");
+  // The ready pose, as the simulated arm starts there.
+  EXPECT_NEAR(last_value_of(run.out, model.joints[0].name),
+              model.joints[0].ready * 180 / 3.141592653589793, 0.01);
+  EXPECT_NEAR(last_value_of(run.out, model.joints[1].name), model.joints[1].ready * 1e3, 0.01);
+  EXPECT_NE(run.out.find(" mm"), std::string::npos);
+}
+
+TEST(CliRtc, BadPeriodsAndRobotsAreRefusedWithExitCode2) {
+  for (const char* args : {"report --period 0.1ms", "report --period 60ms", "report --period fast",
+                           "report --robot nosuchrobot", "marsh --push 9:1"}) {
+    const CliRun run = rccx_cli(args);
+    EXPECT_EQ(run.exit_code, 2) << args << ": " << run.out;
+    EXPECT_NE(run.out.find("error"), std::string::npos) << args << ": " << run.out;
+  }
+}
+
+TEST(CliRtc, CalibCalibratesAnUncalibratedRobot) {
+  const CliRun run = rccx_cli("calib --robot puma560 --uncalibrated");
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  EXPECT_NE(run.out.find("ALL JOINTS calibrated"), std::string::npos) << run.out;
+  EXPECT_EQ(run.out.find("  not calibrated"), std::string::npos) << run.out;
+}
+
+TEST(CliRtc, LimpTurnsArmPowerOff) {
+  const CliRun run = rccx_cli("limp --robot puma260");
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  EXPECT_NE(run.out.find("arm power off"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("(power off)"), std::string::npos) << run.out;
+}
+
+TEST(CliRtc, MarshLetsAPushedJointMoveAndStay) {
+  const auto model = kin::builtin_robot("puma560");
+  // 40 N m: more than joint 1's Coulomb friction (26 N m), so the joint moves.
+  const CliRun run = rccx_cli("marsh --robot puma560 --seconds 2 --every 0.5 --push 1:40");
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  // Four position lines: two while pushed, two after. Joint 1 moved up and then stayed.
+  std::vector<double> theta1;
+  std::size_t at = 0;
+  while ((at = run.out.find(" theta1 ", at)) != std::string::npos) {
+    theta1.push_back(std::stod(run.out.substr(at + 8)));
+    at += 8;
+  }
+  ASSERT_EQ(theta1.size(), 4U) << run.out;
+  EXPECT_GT(theta1[1], theta1[0]) << "joint 1 did not follow the push";
+  EXPECT_GT(theta1[2], model.joints[0].ready * 180 / 3.141592653589793 + 0.5) << run.out;
+  EXPECT_NEAR(theta1[3], theta1[2], 0.05) << "joint 1 did not stay where it was left";
+}
+
+TEST(CliRtc, JointtestMovesAJointFromScriptedCommands) {
+  const CliRun run = rccx_cli_with_input(
+      "jointtest --robot puma560", "?\nj 2\nv 20\nm 60\nw 3\nx\nO 3\nH\nM 40\nw 3\nx\nzz\nq\n");
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  EXPECT_NE(run.out.find("commands (one per line"), std::string::npos) << "no menu";
+  EXPECT_NE(run.out.find("unknown command \"zz\""), std::string::npos) << run.out;
+  // The two examinations: joint 2 at 60 then 40 degrees.
+  const auto first = run.out.find("  2 theta2");
+  ASSERT_NE(first, std::string::npos) << run.out;
+  EXPECT_NEAR(std::stod(run.out.substr(first + 11)), 60.0, 0.01) << run.out;
+  const auto second = run.out.find("  2 theta2", first + 1);
+  ASSERT_NE(second, std::string::npos) << run.out;
+  EXPECT_NEAR(std::stod(run.out.substr(second + 11)), 40.0, 0.01) << run.out;
+  EXPECT_NE(run.out.find("hand closed, outputs 0x0008"), std::string::npos) << run.out;
+}
+
+TEST(CliRtc, JointtestReportsALimitAndCarriesOn) {
+  const CliRun run = rccx_cli_with_input("jointtest --robot puma560", "j 1\nm 500\nw 0.1\nq\n");
+  EXPECT_EQ(run.exit_code, 1) << run.out;
+  EXPECT_NE(run.out.find("commanded outside its limits"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("control restarted"), std::string::npos) << run.out;
+}
+
+TEST(CliRtc, CodesListsEveryTerminateCode) {
+  const CliRun run = rccx_cli("codes");
+  ASSERT_EQ(run.exit_code, 0);
+  for (const char* name : {"overrun", "observed_position", "power_failure", "user_interrupt"}) {
+    EXPECT_NE(run.out.find(name), std::string::npos) << name;
+  }
+}

@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -81,20 +82,14 @@ constexpr const char* kGoodRobot = R"({
   // comments are allowed
   "joints": [
     {"name": "j1", "type": "revolute", "a_m": 0.5, "alpha_deg": 0, "lower_deg": -90,
-     "upper_deg": 90, "resolution_deg_per_count": 0.01, "ready_deg": 0},
+     "upper_deg": 90, "resolution_deg_per_count": 0.01, "ready_deg": 0,
+     "max_velocity_deg_per_s": 90,
+     "dynamics": {"inertia_kg_m2": 2, "viscous_N_m_s_per_rad": 3, "coulomb_N_m": 4,
+                  "max_effort_N_m": 50, "link_mass_kg": 6, "link_com_m": [-0.25, 0, 0.01]}},
     {"name": "j2", "type": "prismatic", "a_m": 0, "alpha_deg": 0, "lower_m": 0, "upper_m": 0.2,
-     "resolution_mm_per_count": 0.01, "ready_m": 0.1}
+     "resolution_mm_per_count": 0.01, "ready_m": 0.1, "max_velocity_mm_per_s": 250}
   ]
 })";
-
-TEST(RobotFile, ParsesWithUnitsConverted) {
-  const kin::RobotModel m = kin::parse_robot(kGoodRobot, "test");
-  ASSERT_EQ(m.dof(), 2u);
-  EXPECT_EQ(m.solver, kin::SolverKind::dh);
-  EXPECT_DOUBLE_EQ(m.joints[0].upper, 90_deg);
-  EXPECT_DOUBLE_EQ(m.joints[1].resolution_per_count, 1e-5);
-  EXPECT_EQ(m.joints[1].type, kin::JointType::prismatic);
-}
 
 void expect_error(const std::string& text, const std::string& fragment) {
   try {
@@ -112,9 +107,43 @@ std::string replaced(std::string text, const std::string& from, const std::strin
   return text;
 }
 
+TEST(RobotFile, ParsesWithUnitsConverted) {
+  const kin::RobotModel m = kin::parse_robot(kGoodRobot, "test");
+  ASSERT_EQ(m.dof(), 2u);
+  EXPECT_EQ(m.solver, kin::SolverKind::dh);
+  EXPECT_DOUBLE_EQ(m.joints[0].upper, 90_deg);
+  EXPECT_DOUBLE_EQ(m.joints[1].resolution_per_count, 1e-5);
+  EXPECT_EQ(m.joints[1].type, kin::JointType::prismatic);
+  EXPECT_DOUBLE_EQ(m.joints[0].max_velocity, 90_deg);
+  EXPECT_DOUBLE_EQ(m.joints[1].max_velocity, 0.25);
+  const kin::JointDynamics& d = m.joints[0].dynamics;
+  EXPECT_EQ(d.inertia, 2.0);
+  EXPECT_EQ(d.viscous_friction, 3.0);
+  EXPECT_EQ(d.coulomb_friction, 4.0);
+  EXPECT_EQ(d.max_effort, 50.0);
+  EXPECT_EQ(d.link_mass_kg, 6.0);
+  EXPECT_EQ(d.link_com_m, (std::array<double, 3>{-0.25, 0.0, 0.01}));
+  // No "dynamics": all zeros ("not given").
+  EXPECT_EQ(m.joints[1].dynamics.inertia, 0.0);
+  EXPECT_EQ(m.joints[1].dynamics.link_mass_kg, 0.0);
+}
+
+TEST(RobotFile, ReadsPrismaticDynamicsInTheirOwnUnits) {
+  const kin::RobotModel m = kin::parse_robot(
+      replaced(kGoodRobot, "\"max_velocity_mm_per_s\": 250",
+               "\"max_velocity_mm_per_s\": 250, \"dynamics\": {\"inertia_kg\": 7, "
+               "\"viscous_N_s_per_m\": 8, \"coulomb_N\": 9, \"max_effort_N\": 300}"),
+      "test");
+  const kin::JointDynamics& d = m.joints[1].dynamics;
+  EXPECT_EQ(d.inertia, 7.0);
+  EXPECT_EQ(d.viscous_friction, 8.0);
+  EXPECT_EQ(d.coulomb_friction, 9.0);
+  EXPECT_EQ(d.max_effort, 300.0);
+}
+
 TEST(RobotFile, RefusesBadInputWithMessagesThatSayWhere) {
   expect_error("{ not json", "not valid JSON");
-  expect_error(replaced(kGoodRobot, "\"ready_deg\": 0}", "\"ready_deg\": 0, \"speed\": 1}"),
+  expect_error(replaced(kGoodRobot, "\"ready_m\": 0.1,", "\"ready_m\": 0.1, \"speed\": 1,"),
                "unknown key \"speed\"");
   expect_error(replaced(kGoodRobot, "\"solver\": \"dh\"", "\"solver\": \"ikfast\""), "solver");
   expect_error(replaced(kGoodRobot, "\"type\": \"revolute\"", "\"type\": \"ball\""), "joint 1");
@@ -122,6 +151,68 @@ TEST(RobotFile, RefusesBadInputWithMessagesThatSayWhere) {
   expect_error(replaced(kGoodRobot, "\"ready_m\": 0.1", "\"ready_m\": 0.5"), "ready");
   expect_error(replaced(kGoodRobot, "\"a_m\": 0.5", "\"a_m\": \"x\""), "\"a_m\" must be a number");
   expect_error(replaced(kGoodRobot, "\"name\": \"two\", ", ""), "missing \"name\"");
+}
+
+TEST(RobotFile, RefusesAMissingOrBadMaxVelocity) {
+  expect_error(replaced(kGoodRobot, ", \"max_velocity_mm_per_s\": 250", ""),
+               "joint 2: missing \"max_velocity_mm_per_s\"");
+  expect_error(replaced(kGoodRobot, "\"max_velocity_deg_per_s\": 90,", ""),
+               "joint 1: missing \"max_velocity_deg_per_s\"");
+  expect_error(
+      replaced(kGoodRobot, "\"max_velocity_deg_per_s\": 90", "\"max_velocity_deg_per_s\": 0"),
+      "joint 1: \"max_velocity_deg_per_s\" must be positive");
+  expect_error(
+      replaced(kGoodRobot, "\"max_velocity_mm_per_s\": 250", "\"max_velocity_mm_per_s\": -1"),
+      "joint 2: \"max_velocity_mm_per_s\" must be positive");
+  expect_error(
+      replaced(kGoodRobot, "\"max_velocity_mm_per_s\": 250", "\"max_velocity_mm_per_s\": \"fast\""),
+      "\"max_velocity_mm_per_s\" must be a number");
+  // The unit must match the joint type.
+  expect_error(
+      replaced(kGoodRobot, "\"max_velocity_mm_per_s\": 250", "\"max_velocity_deg_per_s\": 250"),
+      "joint 2: missing \"max_velocity_mm_per_s\"");
+}
+
+TEST(RobotFile, RefusesBadDynamics) {
+  expect_error(replaced(kGoodRobot, "\"inertia_kg_m2\": 2", "\"inertia_kg_m2\": 2, \"mass\": 1"),
+               "joint 1: dynamics: unknown key \"mass\"");
+  expect_error(replaced(kGoodRobot, "\"inertia_kg_m2\": 2", "\"inertia_kg\": 2"),
+               "joint 1: dynamics: \"inertia_kg\" is for a prismatic joint");
+  expect_error(replaced(kGoodRobot, "\"coulomb_N_m\": 4", "\"coulomb_N_m\": -4"),
+               "joint 1: dynamics: \"coulomb_N_m\" must not be negative");
+  expect_error(replaced(kGoodRobot, "\"max_effort_N_m\": 50", "\"max_effort_N_m\": \"big\""),
+               "\"max_effort_N_m\" must be a number");
+  expect_error(replaced(kGoodRobot, "[-0.25, 0, 0.01]", "[-0.25, 0]"),
+               "joint 1: dynamics: \"link_com_m\" must be [x, y, z]");
+  expect_error(replaced(kGoodRobot, "[-0.25, 0, 0.01]", "[-0.25, 0, \"z\"]"),
+               "\"link_com_m\" must hold three finite numbers");
+  expect_error(replaced(kGoodRobot, "\"dynamics\": {", "\"dynamics\": 3, \"x\": {"),
+               "joint 1: dynamics: expected an object");
+  expect_error(replaced(kGoodRobot, "\"max_velocity_mm_per_s\": 250",
+                        "\"max_velocity_mm_per_s\": 250, \"dynamics\": {\"coulomb_N_m\": 1}"),
+               "joint 2: dynamics: \"coulomb_N_m\" is for a revolute joint");
+}
+
+// Every shipped robot has top speeds; the PUMAs have the dynamics their simulator needs.
+TEST(BuiltinRobots, HaveTopSpeedsAndThePumasDynamics) {
+  for (const auto& name : kin::builtin_robot_names()) {
+    const kin::RobotModel m = kin::builtin_robot(name);
+    for (const kin::Joint& j : m.joints) {
+      EXPECT_GT(j.max_velocity, 0.0) << name << " " << j.name;
+      if (name == "puma560" || name == "puma260") {
+        EXPECT_GT(j.dynamics.inertia, 0.0) << name << " " << j.name;
+        EXPECT_GT(j.dynamics.max_effort, 0.0) << name << " " << j.name;
+        EXPECT_GT(j.dynamics.viscous_friction, 0.0) << name << " " << j.name;
+        EXPECT_GT(j.dynamics.coulomb_friction, 0.0) << name << " " << j.name;
+      }
+    }
+  }
+  // The thesis: joint 3 of the Microbo tops out at about 200 mm/s.
+  EXPECT_NEAR(kin::builtin_robot("microbo").joints[2].max_velocity, 200_mm, 1e-12);
+  // mdl_puma560's link masses.
+  const kin::RobotModel puma = kin::builtin_robot("puma560");
+  const double masses[6] = {0, 17.4, 4.8, 0.82, 0.34, 0.09};
+  for (std::size_t i = 0; i < 6; ++i) EXPECT_EQ(puma.joints[i].dynamics.link_mass_kg, masses[i]);
 }
 
 TEST(RobotFile, LoadsFromDiskAndReportsMissingFiles) {

@@ -19,34 +19,6 @@ namespace {
 
 using json = nlohmann::ordered_json;
 
-/// A bad argument found after parsing: its message goes to stderr and rccx exits with 2.
-struct BadArgument {
-  std::string message;
-};
-
-struct RobotChoice {
-  std::string name = "puma560";
-  std::string file;
-
-  [[nodiscard]] std::unique_ptr<kin::Kinematics> load() const {
-    try {
-      return kin::make_kinematics(file.empty() ? kin::builtin_robot(name)
-                                               : kin::load_robot_file(file));
-    } catch (const kin::RobotFileError& e) {
-      throw BadArgument{e.what()};
-    }
-  }
-};
-
-void add_robot_options(CLI::App& cmd, RobotChoice& robot) {
-  cmd.add_option("--robot", robot.name,
-                 "Shipped robot to use (see `rccx kin robots`): microbo, puma560, puma260")
-      ->capture_default_str();
-  cmd.add_option("--robot-file", robot.file,
-                 "Robot description file (JSON, see robots/README.md); overrides --robot")
-      ->check(CLI::ExistingFile);
-}
-
 std::string unit_of(const kin::Joint& j) {
   return j.type == kin::JointType::revolute ? "rad" : "m";
 }
@@ -105,7 +77,7 @@ std::string format_transform(const math::Transform& T) {
 // ---- rccx kin fk ----
 
 struct FkArgs {
-  RobotChoice robot;
+  RobotChoice robot{"puma560"};
   std::vector<double> q;
   bool degrees = false;
   bool json = false;
@@ -133,7 +105,7 @@ int run_fk(const FkArgs& args) {
 // ---- rccx kin ik ----
 
 struct IkArgs {
-  RobotChoice robot;
+  RobotChoice robot{"puma560"};
   std::vector<double> T;
   std::string config;
   std::vector<double> near;
@@ -293,16 +265,6 @@ int run_robots(bool as_json) {
   }
   if (as_json) fmt::print("{}\n", list.dump());
   return kOk;
-}
-
-template <typename F>
-void guarded(int& exit_code, F&& run) {
-  try {
-    exit_code = run();
-  } catch (const BadArgument& e) {
-    fmt::print(stderr, "error: {}\n", e.message);
-    exit_code = kBadArguments;
-  }
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 #include <CLI/CLI.hpp>
 
 #include "kin_command.hpp"
+#include "rtc_commands.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{
@@ -13,6 +14,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   int exit_code = rccx::tools::kOk;
   rccx::tools::add_kin_command(app, exit_code);
+  rccx::tools::add_rtc_commands(app, exit_code);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

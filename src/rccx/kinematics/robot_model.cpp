@@ -118,6 +118,48 @@ class Reader {
   std::set<std::string> used_;
 };
 
+// The optional "dynamics" object of a joint; its keys carry the unit of the joint's type.
+JointDynamics parse_dynamics(const json& j, JointType type, const std::string& where) {
+  Reader r(j, where);
+  const bool revolute = type == JointType::revolute;
+  // A key of the other joint type's units is named as such rather than as merely unknown.
+  static constexpr std::array<const char*, 4> kRevoluteKeys = {
+      "inertia_kg_m2", "viscous_N_m_s_per_rad", "coulomb_N_m", "max_effort_N_m"};
+  static constexpr std::array<const char*, 4> kPrismaticKeys = {"inertia_kg", "viscous_N_s_per_m",
+                                                                "coulomb_N", "max_effort_N"};
+  const auto& own = revolute ? kRevoluteKeys : kPrismaticKeys;
+  for (const char* wrong : revolute ? kPrismaticKeys : kRevoluteKeys) {
+    if (j.contains(wrong)) {
+      r.fail(fmt::format("\"{}\" is for a {} joint; this one is {}", wrong,
+                         revolute ? "prismatic" : "revolute", to_string(type)));
+    }
+  }
+  const auto non_negative = [&r](const char* key) {
+    const double v = r.number_or(key, 0.0);
+    if (v < 0) r.fail(fmt::format("\"{}\" must not be negative", key));
+    return v;
+  };
+  JointDynamics d;
+  d.inertia = non_negative(own[0]);
+  d.viscous_friction = non_negative(own[1]);
+  d.coulomb_friction = non_negative(own[2]);
+  d.max_effort = non_negative(own[3]);
+  d.link_mass_kg = non_negative("link_mass_kg");
+  if (r.has("link_com_m")) {
+    const json& com = r.get("link_com_m");
+    if (!com.is_array() || com.size() != 3) r.fail("\"link_com_m\" must be [x, y, z]");
+    for (std::size_t i = 0; i < 3; ++i) {
+      if (!com[i].is_number() || !std::isfinite(com[i].get<double>())) {
+        r.fail("\"link_com_m\" must hold three finite numbers");
+      }
+      d.link_com_m[i] = com[i].get<double>();
+    }
+  }
+  r.has("note");
+  r.no_unknown_keys();
+  return d;
+}
+
 Joint parse_joint(const json& j, const std::string& where) {
   Reader r(j, where);
   Joint joint;
@@ -145,10 +187,18 @@ Joint parse_joint(const json& j, const std::string& where) {
     joint.resolution_per_count = r.number("resolution_mm_per_count") * 1e-3;
     joint.ready = r.number("ready_m");
   }
+  const bool revolute = joint.type == JointType::revolute;
+  const char* const velocity_key = revolute ? "max_velocity_deg_per_s" : "max_velocity_mm_per_s";
+  joint.max_velocity =
+      revolute ? math::deg_to_rad(r.number(velocity_key)) : r.number(velocity_key) * 1e-3;
+  if (r.has("dynamics")) {
+    joint.dynamics = parse_dynamics(r.get("dynamics"), joint.type, r.where() + ": dynamics");
+  }
   r.has("note");  // free text, for people
   r.no_unknown_keys();
   if (!(joint.lower < joint.upper)) r.fail("the lower limit must be below the upper limit");
   if (!(joint.resolution_per_count > 0)) r.fail("the encoder resolution must be positive");
+  if (!(joint.max_velocity > 0)) r.fail(fmt::format("\"{}\" must be positive", velocity_key));
   if (joint.ready < joint.lower || joint.ready > joint.upper) {
     r.fail("the ready value lies outside the joint limits");
   }

@@ -4,6 +4,7 @@
 // computed from it per call lives in the solvers (the Model / Data split of Pinocchio).
 #pragma once
 
+#include <array>
 #include <filesystem>
 #include <stdexcept>
 #include <string>
@@ -25,6 +26,17 @@ struct DhParameters {
   double theta_rad = 0.0;
 };
 
+/// What a simulator needs to move a joint like the real one (all optional in a robot file:
+/// zeros mean "not given", and only the simulated PUMA's plant requires them).
+struct JointDynamics {
+  double inertia = 0.0;           ///< effective inertia at the joint, motor reflected: kg m^2 or kg
+  double viscous_friction = 0.0;  ///< N m s/rad or N s/m
+  double coulomb_friction = 0.0;  ///< N m or N
+  double max_effort = 0.0;        ///< motor torque (N m) or force (N) limit at the joint
+  double link_mass_kg = 0.0;      ///< mass of the link this joint moves
+  std::array<double, 3> link_com_m{};  ///< that link's centre of mass in its own DH frame, m
+};
+
 struct Joint {
   std::string name;
   JointType type = JointType::revolute;
@@ -33,6 +45,8 @@ struct Joint {
   double upper = 0.0;                 ///< upper limit, rad or m
   double resolution_per_count = 0.0;  ///< encoder resolution, rad or m per count
   double ready = 0.0;                 ///< value in the robot's ready (nominal) pose, rad or m
+  double max_velocity = 0.0;          ///< fastest commanded or observed speed, rad/s or m/s
+  JointDynamics dynamics;
 };
 
 /// Which solver a model asks for: the thesis's closed form for the Microbo, the PUMA closed

@@ -1,0 +1,50 @@
+// The communication task's side of one robot: read every joint into How, send this sample's
+// joint commands, hold, power. One Driver per robot kind: `ServoDriver` for the simulated
+// servo arms of rccx::hw; the Microbo's register-protocol driver will sit behind the same
+// interface. The communication task calls these every sample: noexcept, no allocation.
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+#include "rccx/kinematics/robot_model.hpp"
+#include "rccx/rtc/types.hpp"
+
+namespace rccx::rtc {
+
+/// One joint's command after the communication task has checked it: joint values, never
+/// outside the limits.
+struct JointCommand {
+  enum class Kind : std::uint8_t { none, move, calibrate };
+  Kind kind = Kind::none;
+  double target = 0.0;  ///< joint value, rad or m
+  double rate = 0.0;    ///< rad/s or m/s at which to travel to target; 0 = at once
+};
+using JointCommands = std::array<JointCommand, kMaxJoints>;
+
+class Driver {
+ public:
+  virtual ~Driver() = default;
+  Driver() = default;
+  Driver(const Driver&) = delete;
+  Driver& operator=(const Driver&) = delete;
+
+  [[nodiscard]] virtual const kin::RobotModel& model() const noexcept = 0;
+
+  /// Reads the arm at time t_s (s since the session opened) into `how`: for each joint q,
+  /// velocity and the flags kCalibrated, kCalibrating, kNotAnswering, kEncoderError; and
+  /// power, hand_closed, outputs. Range values and limit flags are the caller's.
+  virtual void read(double t_s, How& how) noexcept = 0;
+  /// Sends this sample's commands (entries of kind none are skipped).
+  virtual void send(const JointCommands& commands) noexcept = 0;
+  /// Every joint stops where it is and stays.
+  virtual void hold() noexcept = 0;
+  /// Arm power; false when it could not be switched (power failure).
+  virtual bool set_power(bool on) noexcept = 0;
+  virtual void set_hand_closed(bool closed) noexcept = 0;
+  /// Zero gravity: the joints yield to external effort (gravity compensated) and stay.
+  virtual void set_zero_gravity(bool on) noexcept = 0;
+  virtual void set_outputs(std::uint16_t bits) noexcept = 0;
+};
+
+}  // namespace rccx::rtc

@@ -1,0 +1,37 @@
+// Wake-up latency of the communication task in real time: how late each tick's thread woke
+// after its absolute deadline, in a fixed histogram (1 us bins up to 20 ms) written by the
+// communication task without allocating, read by the planning level.
+#pragma once
+
+#include <array>
+#include <atomic>
+#include <cstdint>
+#include <memory>
+
+namespace rccx::rtc {
+
+struct LatencyStats {
+  std::uint64_t wakeups = 0;           ///< ticks measured
+  std::uint64_t missed_deadlines = 0;  ///< ticks skipped because a wake-up came a period late
+  double p50_us = 0.0, p99_us = 0.0, p999_us = 0.0, max_us = 0.0;
+};
+
+class LatencyHistogram {
+ public:
+  static constexpr std::size_t kBins = 20'000;  ///< 1 us each; the last one takes the rest
+
+  LatencyHistogram();
+  /// Communication task: one wake-up `late_ns` after its deadline.
+  void record(std::int64_t late_ns) noexcept;
+  void record_missed(std::uint64_t ticks) noexcept;
+  void reset() noexcept;
+  [[nodiscard]] LatencyStats stats() const;
+
+ private:
+  std::unique_ptr<std::array<std::atomic<std::uint32_t>, kBins>> bins_;
+  std::atomic<std::uint64_t> count_{0};
+  std::atomic<std::uint64_t> missed_{0};
+  std::atomic<std::int64_t> max_ns_{0};
+};
+
+}  // namespace rccx::rtc

@@ -1,0 +1,91 @@
+#include "rccx/rtc/servo_driver.hpp"
+
+namespace rccx::rtc {
+
+ServoDriver::ServoDriver(hw::SimulatedArm& arm) noexcept : arm_(arm) {}
+
+void ServoDriver::read(double t_s, How& how) noexcept {
+  arm_.advance_to(t_s);
+  const auto& joints = arm_.model().joints;
+  const std::size_t n = joints.size();
+  how.dof = static_cast<std::uint8_t>(n);
+
+  Sample& now = history_[reads_ % kHistory];
+  const Sample* before = reads_ > 0 ? &history_[(reads_ - 1) % kHistory] : nullptr;
+  now.t_s = t_s;
+  now.q = JointVector(n);
+  bool all_calibrated = true;
+  for (std::size_t i = 0; i < n; ++i) {
+    const hw::JointReading r = arm_.read(i);
+    std::uint16_t flags = 0;
+    if (!r.answered) {
+      flags |= kNotAnswering;
+      now.q[i] = before ? before->q[i] : how.joint[i].q;  // keep the last known value
+    } else {
+      now.q[i] = static_cast<double>(r.counts) * joints[i].resolution_per_count;
+      if (r.encoder_error) flags |= kEncoderError;
+    }
+    if (r.calibrated) flags |= kCalibrated;
+    // Calibration makes the counts absolute: the jump is not motion, so the speed starts over.
+    if (before && r.calibrated != ((how.joint[i].flags & kCalibrated) != 0)) {
+      for (Sample& old : history_) old.q[i] = now.q[i];
+    }
+    if (r.calibrating) flags |= kCalibrating;
+    all_calibrated = all_calibrated && r.calibrated;
+    how.joint[i].q = now.q[i];
+    how.joint[i].flags = flags;
+  }
+
+  // Speed over the newest sample at least a window old (or the oldest kept).
+  const Sample* old = nullptr;
+  const std::size_t kept = std::min(reads_, kHistory - 1);
+  for (std::size_t back = 1; back <= kept; ++back) {
+    old = &history_[(reads_ - back) % kHistory];
+    if (t_s - old->t_s >= kVelocityWindow_s) break;
+  }
+  const double dt = old ? t_s - old->t_s : 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    how.joint[i].velocity = dt > 0.0 ? (now.q[i] - old->q[i]) / dt : 0.0;
+  }
+  ++reads_;
+
+  how.all_calibrated = all_calibrated;
+  how.power = arm_.power();
+  how.hand_closed = arm_.hand_closed();
+  how.outputs = arm_.outputs();
+}
+
+void ServoDriver::send(const JointCommands& commands) noexcept {
+  for (std::size_t i = 0; i < arm_.dof(); ++i) {
+    const JointCommand& c = commands[i];
+    switch (c.kind) {
+      case JointCommand::Kind::none:
+        break;
+      case JointCommand::Kind::move:
+        arm_.command(i, {hw::ServoCommand::Kind::move, c.target, c.rate});
+        break;
+      case JointCommand::Kind::calibrate:
+        arm_.command(i, {hw::ServoCommand::Kind::calibrate, 0.0, 0.0});
+        break;
+    }
+  }
+}
+
+void ServoDriver::hold() noexcept {
+  for (std::size_t i = 0; i < arm_.dof(); ++i) arm_.command(i, {});
+}
+
+bool ServoDriver::set_power(bool on) noexcept {
+  return arm_.set_power(on);
+}
+void ServoDriver::set_hand_closed(bool closed) noexcept {
+  arm_.set_hand_closed(closed);
+}
+void ServoDriver::set_zero_gravity(bool on) noexcept {
+  arm_.set_zero_gravity(on);
+}
+void ServoDriver::set_outputs(std::uint16_t bits) noexcept {
+  arm_.set_outputs(bits);
+}
+
+}  // namespace rccx::rtc

@@ -1,0 +1,179 @@
+// An RTC session (thesis 2.3 and 4.5): open it on a robot's driver, start control with two
+// user functions run once per sample, release, control again, close. Two threads serve it,
+// as the thesis's two processors did (figure 4.7):
+//
+//   communication task: at each tick reads the arm into How, checks limits and faults, hands
+//                       How over; takes Chg after f1 and turns it into joint commands while
+//                       the control task runs f2; checks that the last control cycle finished.
+//   control task:       copies How, runs f1, hands Chg over, runs f2, kicks the watchdog.
+//
+// They exchange How and Chg through sequence counters (acquire/release atomics and futex
+// waits): no mutex, no allocation in the sample loop. A termination (limit, fault, overrun,
+// Ctrl-C, or a request) leaves the arm holding where it is, or powered down for power and
+// communication faults, and is reported to the planning level by the wait functions.
+//
+// Time is a `ClockKind`: real time (absolute-deadline sleeps, SCHED_FIFO and locked memory when
+// allowed), or simulated time, which advances one sample at a time and only while the program
+// waits in this class's wait functions, so a simulated run is deterministic and fast.
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <thread>
+
+#include "rccx/rtc/driver.hpp"
+#include "rccx/rtc/latency.hpp"
+#include "rccx/rtc/types.hpp"
+
+namespace rccx::rtc {
+
+enum class ClockKind : std::uint8_t {
+  simulated,  ///< deterministic; advances only while the program waits in the session
+  real_time,  ///< the monotonic clock
+};
+
+/// The sample periods RTC accepts (the thesis ran 28 and 56 ms; modern controllers 1 ms).
+inline constexpr std::chrono::nanoseconds kMinPeriod{250'000};
+inline constexpr std::chrono::nanoseconds kMaxPeriod{56'000'000};
+/// A POS command without a velocity moves the joint at this fraction of its maximum speed.
+inline constexpr double kDefaultSpeedFraction = 0.25;
+
+struct SessionOptions {
+  std::chrono::nanoseconds period{std::chrono::milliseconds(10)};  ///< 0.25 ms .. 56 ms
+  ClockKind clock = ClockKind::simulated;
+  /// Real time only: ask for SCHED_FIFO and mlockall (said once on stderr when not allowed).
+  bool real_time_scheduling = true;
+  /// Simulated time only: a control cycle still running after this much wall time is taken
+  /// as hung and the session ends with `overrun`.
+  std::chrono::milliseconds hang_timeout{std::chrono::seconds(5)};
+  /// Real time only: record wake-up latency of the communication task.
+  bool measure_latency = true;
+};
+
+/// A misuse of the session or a bad option: says what to do instead.
+class SessionError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+class Session;
+
+/// What a control function sees: the How of its sample, the Chg it may write, and the
+/// session's `terminate` and `rtc_message`.
+class Control {
+ public:
+  [[nodiscard]] const How& how() const noexcept { return how_; }
+  [[nodiscard]] Chg& chg() noexcept { return chg_; }
+  [[nodiscard]] double period_s() const noexcept { return period_s_; }
+  /// Ends the session (the `terminate` variable); the arm holds.
+  void terminate(TerminateCode code = TerminateCode::user_request) noexcept;
+  /// Sets rtc_message, the text the planning level gets with the termination (truncated to
+  /// kMessageCapacity - 1 characters).
+  void message(std::string_view text) noexcept;
+  /// Charges `d` of computing to this cycle: in simulated time it counts toward the period
+  /// (so an overrun can be simulated deterministically); in real time it busy-waits.
+  void spend(std::chrono::nanoseconds d) noexcept;
+
+ private:
+  friend class Session;
+  How how_;
+  Chg chg_;
+  double period_s_ = 0.0;
+  std::int64_t spent_ns_ = 0;
+  Session* session_ = nullptr;
+  std::array<char, kMessageCapacity> message_{};
+};
+
+/// A control function, f1 or f2. It must return within the sample period; it may throw (the
+/// session ends with `control_exception`) but should not.
+using ControlFunction = std::function<void(Control&)>;
+
+class Session {
+ public:
+  /// rtc_open: starts the communication task (the arm is read every period from now on) and
+  /// the idle control task. Throws SessionError for a period outside [kMinPeriod, kMaxPeriod].
+  Session(Driver& driver, SessionOptions options = {});
+  /// rtc_close without powering down.
+  ~Session();
+  Session(const Session&) = delete;
+  Session& operator=(const Session&) = delete;
+
+  /// rtc_control: starts calling f1 and f2 every sample, from the next sample on; returns at
+  /// once. Either may be empty. Throws SessionError when control is already active.
+  void control(ControlFunction f1, ControlFunction f2);
+  /// rtc_release: stops control (the arm holds) and returns how it ended (`code` none if it
+  /// was still running). Control may be started again after it.
+  Termination release(bool power_off = false);
+  /// rtc_close: releases and stops both tasks. Called by the destructor.
+  void close(bool power_off = false);
+
+  /// Ends the session from the planning level (the `terminate` variable).
+  void terminate(TerminateCode code = TerminateCode::user_request) noexcept;
+
+  /// Lets `d` of time pass (in simulated time: runs those samples). Returns the termination
+  /// if control ended meanwhile (or before), an empty one otherwise.
+  Termination wait_for(std::chrono::nanoseconds d);
+  /// Waits until control ends or `timeout` passes; returns the termination (code none on
+  /// timeout).
+  Termination wait_terminated(std::chrono::nanoseconds timeout);
+  /// Waits until `done(how)` holds for a sample's How, control ends, or `timeout` passes.
+  /// True when the condition held.
+  bool wait_until(const std::function<bool(const How&)>& done, std::chrono::nanoseconds timeout);
+
+  /// The last How the communication task read (copied; safe from the planning level).
+  [[nodiscard]] How how() const;
+  [[nodiscard]] bool controlling() const noexcept;
+  /// The termination of the present or last control session (code none while it runs).
+  [[nodiscard]] Termination termination() const;
+  [[nodiscard]] std::chrono::nanoseconds period() const noexcept { return period_; }
+  /// Changes the sample period; only while control is not active.
+  void set_period(std::chrono::nanoseconds period);
+  [[nodiscard]] ClockKind clock() const noexcept { return options_.clock; }
+  [[nodiscard]] Driver& driver() noexcept { return driver_; }
+  /// Wake-up latency of the communication task (real time only).
+  [[nodiscard]] LatencyStats latency() const;
+
+  /// user_hangup: replaces what Ctrl-C does during control (default: terminate with
+  /// user_interrupt). Runs on a helper thread, not in the sample loop.
+  void set_hangup_handler(std::function<void(Session&)> handler);
+  /// Called by the hang-up watcher thread.
+  void hangup();
+
+ private:
+  friend class Control;
+  struct Shared;
+  struct CommState;
+
+  void communication_task() noexcept;
+  bool wait_tick(CommState& c) noexcept;
+  void communication_cycle(CommState& c) noexcept;
+  void controlled_cycle(CommState& c) noexcept;
+  void apply(CommState& c, const Chg& chg) noexcept;
+  void end_control(CommState& c, TerminateCode code, int joint, std::string_view detail) noexcept;
+  void control_task() noexcept;
+  void control_cycle(std::uint32_t k) noexcept;
+  void request_termination(TerminateCode code, int joint) noexcept;
+  void step_simulated_sample();
+  void wait_control_idle() const;
+  [[nodiscard]] Termination ended_termination() const;
+  void check_period(std::chrono::nanoseconds p) const;
+
+  Driver& driver_;
+  SessionOptions options_;
+  std::chrono::nanoseconds period_;
+  std::unique_ptr<Shared> shared_;
+  std::function<void(Session&)> hangup_handler_;
+  ControlFunction f1_, f2_;
+  std::uint32_t simulated_ticks_ = 0;  ///< planning side: ticks granted in simulated time
+  std::thread communication_thread_;
+  std::thread control_thread_;
+  bool closed_ = false;
+};
+
+}  // namespace rccx::rtc

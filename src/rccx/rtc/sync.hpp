@@ -1,0 +1,71 @@
+// The waits between RTC's tasks: "doorbells", 32-bit counters that a waker bumps after changing
+// what a sleeper watches. A sleeper spins briefly (the other task usually answers within
+// microseconds, and a futex wake-up costs tens of them on a virtual machine), then sleeps on
+// the futex until rung or until an absolute deadline on the monotonic clock. Ringing makes the
+// wake system call only when somebody sleeps. No mutex anywhere; sleepers re-check their
+// condition after every return.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+
+namespace rccx::rtc::detail {
+
+/// Monotonic clock, ns.
+std::int64_t monotonic_ns() noexcept;
+
+struct Doorbell {
+  std::atomic<std::uint32_t> rings{0};
+  std::atomic<std::uint32_t> sleepers{0};
+  [[nodiscard]] std::uint32_t load() const noexcept {
+    return rings.load(std::memory_order_seq_cst);
+  }
+};
+
+/// How long a waiter spins before it sleeps: about 10 to 30 us of pause instructions, longer
+/// than a hand-over between two running tasks, far shorter than a sample period.
+inline constexpr int kSpins = 4000;
+
+/// Waits while the bell still shows `seen` (from bell.load() before checking the condition),
+/// until rung or `deadline_ns` (monotonic; <= 0: no deadline), spinning `spins` times before
+/// sleeping. Spurious returns are allowed.
+void wait_while(Doorbell& bell, std::uint32_t seen, std::int64_t deadline_ns = 0,
+                int spins = kSpins) noexcept;
+
+/// Rings the bell: wakes everyone waiting on it.
+void ring(Doorbell& bell) noexcept;
+
+/// Sleeps until the absolute monotonic time `deadline_ns`.
+void sleep_until(std::int64_t deadline_ns) noexcept;
+
+/// a is at or after b, for sample numbers that may wrap at 2^32.
+constexpr bool reached(std::uint32_t a, std::uint32_t b) noexcept {
+  return static_cast<std::int32_t>(a - b) >= 0;
+}
+
+/// A triple buffer: one writer publishes values without waiting, one reader takes the newest.
+template <class T>
+class Latest {
+ public:
+  /// Writer: publishes v.
+  void publish(const T& v) noexcept {
+    buffers_[write_] = v;
+    write_ = static_cast<std::uint8_t>(
+        middle_.exchange(write_ | kFresh, std::memory_order_acq_rel) & kIndex);
+  }
+  /// Reader: the newest value into out; false when nothing new was published since last time.
+  bool take(T& out) noexcept {
+    if ((middle_.load(std::memory_order_acquire) & kFresh) == 0) return false;
+    read_ = static_cast<std::uint8_t>(middle_.exchange(read_, std::memory_order_acq_rel) & kIndex);
+    out = buffers_[read_];
+    return true;
+  }
+
+ private:
+  static constexpr std::uint8_t kFresh = 4, kIndex = 3;
+  T buffers_[3]{};
+  std::atomic<std::uint8_t> middle_{1};
+  std::uint8_t write_ = 0, read_ = 2;
+};
+
+}  // namespace rccx::rtc::detail

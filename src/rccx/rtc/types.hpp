@@ -1,0 +1,160 @@
+// The RTC data structures of thesis 2.3.2 and 4.5.4.1: `How`, the state of the arm as the
+// communication task read it this sample; `Chg`, the commands the control functions hand it;
+// and the terminate codes that say why a control session ended. Plain values, fixed size:
+// they are copied between the two tasks every sample and must never touch the heap.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <cstdio>
+#include <span>
+#include <string_view>
+
+#include "rccx/kinematics/joint_vector.hpp"
+
+namespace rccx::rtc {
+
+using kin::JointVector;
+using kin::kMaxJoints;
+
+/// How a joint is to be commanded this sample (thesis 4.5.4.1, `chg.i.motion[i].set`).
+enum class SetMode : std::uint8_t {
+  none,     ///< leave the joint as it is
+  pos,      ///< move to the target at the joint's velocity setting (`JointChg::velocity`)
+  posvel,   ///< arrive at the target exactly one sample period from now
+  stopcal,  ///< stop and seek the calibration position (joint-level calibration)
+};
+std::string_view to_string(SetMode m) noexcept;
+
+/// Per-joint command. Positions are range values: zero at the joint's lower limit, rad or m.
+struct JointChg {
+  SetMode set = SetMode::none;
+  double range_target = 0.0;  ///< rad or m above the joint's lower limit
+  double velocity = 0.0;      ///< POS only: rad/s or m/s; 0 = the robot's default speed
+};
+
+/// Which limit checks the communication task makes (thesis 4.5.2, "checking mode"); a bit set.
+enum Check : std::uint8_t {
+  kCheckObservedPosition = 1U << 0,  ///< a measured joint outside its limits ends the session
+  kCheckTargetPosition = 1U << 1,    ///< a target outside the limits ends the session
+  kCheckObservedVelocity = 1U << 2,  ///< a measured speed above the joint's maximum ends it
+  kCheckTargetVelocity = 1U << 3,    ///< a commanded speed above the joint's maximum ends it
+  kCheckAll = 0x0f,
+};
+
+enum class Request : std::uint8_t { none, on, off };
+
+/// The command vehicle: written by the control functions, handed to the communication task
+/// once per sample (after f1). Commands are one-shot (cleared after each hand-over); the
+/// checking mode stays as set.
+struct Chg {
+  std::array<JointChg, kMaxJoints> motion{};
+  std::uint8_t checking = kCheckAll;     ///< `Check` bits
+  Request power = Request::none;         ///< arm power on / off
+  Request hand = Request::none;          ///< on = close the hand, off = open it
+  Request zero_gravity = Request::none;  ///< on: the joints yield to a push and stay ("marsh")
+  std::uint16_t outputs_set = 0;         ///< output bits to set this sample
+  std::uint16_t outputs_clear = 0;       ///< output bits to clear this sample
+
+  /// Conveniences; `joint` is 0-based.
+  void pos(std::size_t joint, double range_target, double velocity = 0.0) noexcept {
+    motion[joint] = {SetMode::pos, range_target, velocity};
+  }
+  void posvel(std::size_t joint, double range_target) noexcept {
+    motion[joint] = {SetMode::posvel, range_target, 0.0};
+  }
+  void stopcal(std::size_t joint) noexcept { motion[joint] = {SetMode::stopcal, 0.0, 0.0}; }
+  /// Clears the one-shot commands, keeps the checking mode.
+  void clear_commands() noexcept {
+    const std::uint8_t keep = checking;
+    *this = Chg{};
+    checking = keep;
+  }
+};
+
+/// Per-joint status bits in `JointHow::flags`.
+enum JointFlag : std::uint16_t {
+  kCalibrated = 1U << 0,           ///< positions are absolute
+  kCalibrating = 1U << 1,          ///< a STOPCAL is still seeking
+  kNotAnswering = 1U << 2,         ///< the joint's controller did not answer this sample
+  kEncoderError = 1U << 3,         ///< the joint's controller flags its encoder
+  kObservedPositionOut = 1U << 4,  ///< measured position outside the limits
+  kTargetPositionOut = 1U << 5,    ///< a commanded target outside the limits (not sent)
+  kObservedVelocityOut = 1U << 6,  ///< measured speed above the joint's maximum
+  kTargetVelocityOut = 1U << 7,    ///< a commanded speed above the joint's maximum (not sent)
+  kNotCalibratedTarget = 1U << 8,  ///< a position target for a joint that is not calibrated
+};
+
+struct JointHow {
+  double range = 0.0;     ///< range value: rad or m above the lower limit
+  double q = 0.0;         ///< joint value, rad or m
+  double velocity = 0.0;  ///< rad/s or m/s
+  std::uint16_t flags = 0;
+  [[nodiscard]] bool has(JointFlag f) const noexcept { return (flags & f) != 0; }
+};
+
+/// The state of the arm, as read by the communication task at the start of a sample.
+struct How {
+  std::uint64_t sample = 0;  ///< sample number since the session was opened (first is 1)
+  double time_s = 0.0;       ///< time of this sample, s since the session was opened
+  std::uint8_t dof = 0;
+  std::array<JointHow, kMaxJoints> joint{};
+  bool power = false;  ///< arm power on
+  bool hand_closed = false;
+  bool all_calibrated = false;  ///< every joint calibrated (the thesis's "ALL JOINTS")
+  std::uint16_t outputs = 0;    ///< the output bits as they stand
+
+  [[nodiscard]] JointVector q() const noexcept;
+  [[nodiscard]] JointVector range() const noexcept;
+  [[nodiscard]] JointVector velocity() const noexcept;
+  /// The flags of all joints or-ed together.
+  [[nodiscard]] std::uint16_t any_flags() const noexcept;
+};
+
+/// Why a control session ended (the `terminate` variable). `none` while it runs.
+enum class TerminateCode : std::int32_t {
+  none = 0,
+  user_request = 1,          ///< a control function or the program asked to end
+  user_interrupt = 2,        ///< Ctrl-C (the default hang-up handler)
+  control_exception = 3,     ///< a control function threw
+  overrun = 10,              ///< a control cycle did not finish within its sample period
+  observed_position = 20,    ///< a joint was measured outside its limits
+  target_position = 21,      ///< a joint was commanded outside its limits
+  observed_velocity = 22,    ///< a joint was measured faster than its maximum speed
+  target_velocity = 23,      ///< a joint was commanded faster than its maximum speed
+  not_calibrated = 24,       ///< a position target for a joint that is not calibrated
+  joint_not_answering = 30,  ///< a joint's controller stopped answering (arm powered down)
+  encoder_error = 31,        ///< a joint's encoder failed
+  power_failure = 32,        ///< arm power was lost (or could not be turned on)
+};
+
+/// What each code means, one line, for people.
+std::string_view describe(TerminateCode code) noexcept;
+std::string_view to_string(TerminateCode code) noexcept;
+/// Every code, in order (for `rccx rtc codes` and the tests).
+std::span<const TerminateCode> all_terminate_codes() noexcept;
+/// True for the codes after which the arm is powered down rather than held.
+bool powers_down(TerminateCode code) noexcept;
+
+inline constexpr std::size_t kMessageCapacity = 128;
+
+/// How a control session ended: the terminate code, where, when, and the `rtc_message`.
+struct Termination {
+  TerminateCode code = TerminateCode::none;
+  int joint = 0;             ///< 1-based joint the code is about, 0 when none
+  std::uint64_t sample = 0;  ///< the sample in which the session ended
+  double time_s = 0.0;
+  std::array<char, kMessageCapacity> message{};  ///< rtc_message: a control function's last word
+  std::array<char, kMessageCapacity> detail{};   ///< what the communication task saw
+
+  [[nodiscard]] bool ended() const noexcept { return code != TerminateCode::none; }
+  [[nodiscard]] std::string_view message_view() const noexcept;
+  [[nodiscard]] std::string_view detail_view() const noexcept;
+};
+
+/// Prints the termination's meaning on one line (the thesis's print_terminate_code()).
+void print_terminate_code(const Termination& t, std::FILE* out = stdout);
+/// Prints every terminate code with its meaning.
+void print_terminate_codes(std::FILE* out = stdout);
+
+}  // namespace rccx::rtc

@@ -1,0 +1,66 @@
+// What the rccx subcommands share: exit codes, the bad-argument error, the robot options.
+#pragma once
+
+#include <fmt/format.h>
+
+#include <CLI/CLI.hpp>
+#include <memory>
+#include <string>
+
+#include "rccx/kinematics/kinematics.hpp"
+
+namespace rccx::tools {
+
+/// Exit codes shared by the rccx subcommands.
+enum ExitCode : int { kOk = 0, kFailure = 1, kBadArguments = 2, kUnreachable = 3 };
+
+/// A bad argument found after parsing: its message goes to stderr and rccx exits with 2.
+struct BadArgument {
+  std::string message;
+};
+
+/// --robot / --robot-file.
+struct RobotChoice {
+  std::string name;
+  std::string file;
+
+  explicit RobotChoice(std::string default_name) : name(std::move(default_name)) {}
+
+  [[nodiscard]] kin::RobotModel model() const {
+    try {
+      return file.empty() ? kin::builtin_robot(name) : kin::load_robot_file(file);
+    } catch (const kin::RobotFileError& e) {
+      throw BadArgument{e.what()};
+    }
+  }
+  [[nodiscard]] std::unique_ptr<kin::Kinematics> load() const {
+    try {
+      return kin::make_kinematics(model());
+    } catch (const kin::RobotFileError& e) {
+      throw BadArgument{e.what()};
+    }
+  }
+};
+
+inline void add_robot_options(CLI::App& cmd, RobotChoice& robot) {
+  cmd.add_option("--robot", robot.name,
+                 "Shipped robot to use (see `rccx kin robots`): microbo, puma560, puma260, "
+                 "stanford")
+      ->capture_default_str();
+  cmd.add_option("--robot-file", robot.file,
+                 "Robot description file (JSON, see robots/README.md); overrides --robot")
+      ->check(CLI::ExistingFile);
+}
+
+/// Runs a subcommand, turning a BadArgument into its message and exit code 2.
+template <typename F>
+void guarded(int& exit_code, F&& run) {
+  try {
+    exit_code = run();
+  } catch (const BadArgument& e) {
+    fmt::print(stderr, "error: {}\n", e.message);
+    exit_code = kBadArguments;
+  }
+}
+
+}  // namespace rccx::tools

@@ -1,0 +1,658 @@
+#include "rtc_commands.hpp"
+
+#include <fmt/format.h>
+#include <poll.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <boost/lockfree/spsc_queue.hpp>
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "rccx/hw/simulated_arm.hpp"
+#include "rccx/math/units.hpp"
+#include "rccx/rtc/servo_driver.hpp"
+#include "rccx/rtc/session.hpp"
+
+namespace rccx::tools {
+
+namespace {
+
+using namespace std::chrono_literals;
+using Seconds = std::chrono::duration<double>;
+
+std::chrono::nanoseconds to_ns(double seconds) {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(Seconds(seconds));
+}
+
+/// "1ms", "250us", "0.028s"; a bare number is in ms.
+std::chrono::nanoseconds parse_period(const std::string& text) {
+  std::size_t used = 0;
+  double value = 0;
+  try {
+    value = std::stod(text, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  const std::string unit = text.substr(used);
+  double scale = 0;
+  if (unit.empty() || unit == "ms") scale = 1e-3;
+  if (unit == "us") scale = 1e-6;
+  if (unit == "s") scale = 1.0;
+  if (used == 0 || scale == 0 || !(value > 0)) {
+    throw BadArgument{
+        fmt::format("--period: \"{}\" is not a duration; write e.g. 1ms, 250us or 0.028s", text)};
+  }
+  const auto p = to_ns(value * scale);
+  if (p < rtc::kMinPeriod || p > rtc::kMaxPeriod) {
+    throw BadArgument{
+        fmt::format("--period: {} is outside the range RTC serves, 0.25 ms to 56 ms", text)};
+  }
+  return p;
+}
+
+/// What every control program takes.
+struct RtcArgs {
+  RobotChoice robot{"puma560"};
+  std::string period = "10ms";
+  bool realtime = false;
+  bool uncalibrated = false;
+};
+
+void add_rtc_options(CLI::App& cmd, RtcArgs& a) {
+  add_robot_options(cmd, a.robot);
+  cmd.add_option("--period", a.period, "Sample period: 0.25ms to 56ms (e.g. 1ms, 28ms)")
+      ->capture_default_str();
+  cmd.add_flag("--realtime", a.realtime,
+               "Run in real time (SCHED_FIFO when allowed) instead of simulated time, which is "
+               "deterministic and runs as fast as the machine allows");
+  cmd.add_flag("--uncalibrated", a.uncalibrated,
+               "Start the simulated robot uncalibrated (encoders relative to power-up)");
+}
+
+/// A simulated robot below the wire and an RTC session on it.
+struct SimulatedRobot {
+  kin::RobotModel model;
+  std::unique_ptr<hw::SimulatedArm> arm;
+  std::unique_ptr<rtc::ServoDriver> driver;
+  std::unique_ptr<rtc::Session> session;
+
+  explicit SimulatedRobot(const RtcArgs& a) : model(a.robot.model()) {
+    rtc::SessionOptions options;
+    options.period = parse_period(a.period);
+    options.clock = a.realtime ? rtc::ClockKind::real_time : rtc::ClockKind::simulated;
+    hw::SimulatedArmOptions arm_options;
+    arm_options.calibrated = !a.uncalibrated;
+    try {
+      arm = hw::make_simulated_arm(model, arm_options);
+    } catch (const std::invalid_argument& e) {
+      throw BadArgument{fmt::format("robot {} cannot be simulated: {}", model.name, e.what())};
+    }
+    driver = std::make_unique<rtc::ServoDriver>(*arm);
+    session = std::make_unique<rtc::Session>(*driver, options);
+  }
+  [[nodiscard]] bool simulated() const { return session->clock() == rtc::ClockKind::simulated; }
+  [[nodiscard]] double period_s() const { return Seconds(session->period()).count(); }
+};
+
+bool revolute(const kin::Joint& j) {
+  return j.type == kin::JointType::revolute;
+}
+/// SI to what people read: degrees, millimetres.
+double shown(const kin::Joint& j, double si) {
+  return revolute(j) ? math::rad_to_deg(si) : si * 1e3;
+}
+double from_shown(const kin::Joint& j, double value) {
+  return revolute(j) ? math::deg_to_rad(value) : value * 1e-3;
+}
+const char* unit(const kin::Joint& j) {
+  return revolute(j) ? "deg" : "mm";
+}
+
+void print_positions(const kin::RobotModel& m, const rtc::How& h) {
+  fmt::print("t {:8.3f} s ", h.time_s);
+  for (std::size_t i = 0; i < h.dof; ++i) {
+    const kin::Joint& j = m.joints[i];
+    fmt::print(" {} {:.3f} {}", j.name, shown(j, h.joint[i].q), unit(j));
+  }
+  if (!h.all_calibrated) fmt::print("  (not calibrated)");
+  if (!h.power) fmt::print("  (power off)");
+  fmt::print("\n");
+}
+
+void print_positions_detailed(const kin::RobotModel& m, const rtc::How& h) {
+  fmt::print("t = {:.3f} s, sample {}, power {}, hand {}, outputs 0x{:04x}\n", h.time_s, h.sample,
+             h.power ? "on" : "off", h.hand_closed ? "closed" : "open", h.outputs);
+  for (std::size_t i = 0; i < h.dof; ++i) {
+    const kin::Joint& j = m.joints[i];
+    const rtc::JointHow& jh = h.joint[i];
+    fmt::print("  {} {:<7} {:10.3f} {:<3}  range {:10.3f} {:<3}  speed {:9.3f} {}/s{}{}\n", i + 1,
+               j.name, shown(j, jh.q), unit(j), shown(j, jh.range), unit(j), shown(j, jh.velocity),
+               unit(j), jh.has(rtc::kCalibrated) ? "" : "  not calibrated",
+               jh.has(rtc::kCalibrating) ? "  calibrating" : "");
+  }
+}
+
+int report_termination(const rtc::Termination& t) {
+  if (!t.ended()) return kOk;
+  rtc::print_terminate_code(t, stderr);
+  return kFailure;
+}
+
+// ---------------------------------------------------------------------------------------------
+
+struct ReportArgs : RtcArgs {
+  double seconds = 2.0;
+  double every = 0.5;
+  bool json = false;
+};
+
+int run_report(const ReportArgs& a) {
+  if (!(a.seconds > 0) || !(a.every > 0)) throw BadArgument{"--seconds and --every must be > 0"};
+  SimulatedRobot r(a);
+  r.session->control({}, {});  // empty f1 and f2: the full cycle, nothing commanded
+  const std::int64_t lines = std::max<std::int64_t>(1, std::llround(a.seconds / a.every));
+  // In real time an overrun says the machine missed a deadline: count it and go on measuring.
+  std::uint64_t overruns = 0;
+  rtc::Termination t;
+  for (std::int64_t i = 0; i < lines && !t.ended(); ++i) {
+    t = r.session->wait_for(to_ns(a.every));
+    if (!a.json) print_positions(r.model, r.session->how());
+    if (a.realtime && t.code == rtc::TerminateCode::overrun) {
+      ++overruns;
+      if (!a.json) rtc::print_terminate_code(t, stdout);
+      r.session->release();
+      r.session->control({}, {});
+      t = {};
+    }
+  }
+  if (!t.ended()) t = r.session->release();
+  if (a.realtime) {  // the figures up to the end, even when control ended early
+    const rtc::LatencyStats s = r.session->latency();
+    if (a.json) {
+      nlohmann::ordered_json j{{"period_us", Seconds(r.session->period()).count() * 1e6},
+                               {"seconds", a.seconds},
+                               {"wakeups", s.wakeups},
+                               {"missed_deadlines", s.missed_deadlines},
+                               {"p50_us", s.p50_us},
+                               {"p99_us", s.p99_us},
+                               {"p999_us", s.p999_us},
+                               {"max_us", s.max_us},
+                               {"overruns", overruns}};
+      fmt::print("{}\n", j.dump(2));
+    } else {
+      fmt::print(
+          "wake-up latency over {} ticks at {:.3f} ms: p50 {:.0f} us, p99 {:.0f} us, p99.9 "
+          "{:.0f} us, max {:.0f} us; missed deadlines {}; control overruns {}\n",
+          s.wakeups, r.period_s() * 1e3, s.p50_us, s.p99_us, s.p999_us, s.max_us,
+          s.missed_deadlines, overruns);
+    }
+  }
+  return report_termination(t);
+}
+
+// ---------------------------------------------------------------------------------------------
+
+struct CalibArgs : RtcArgs {
+  double timeout = 120.0;
+};
+
+int run_calib(const CalibArgs& a) {
+  SimulatedRobot r(a);
+  const rtc::How before = r.session->how();
+  fmt::print("calibrating the {} joints of {} ({}): each seeks its calibration position\n",
+             r.model.dof(), r.model.title,
+             before.all_calibrated ? "re-calibration" : "not calibrated");
+  std::atomic<bool> sent{false};
+  r.session->control(
+      [&sent](rtc::Control& c) {
+        if (sent.load(std::memory_order_relaxed)) return;
+        for (std::size_t i = 0; i < c.how().dof; ++i) c.chg().stopcal(i);
+        sent.store(true, std::memory_order_release);
+      },
+      {});
+  const std::uint64_t start = r.session->how().sample;
+  const bool done = r.session->wait_until(
+      [&](const rtc::How& h) {
+        if (h.sample <= start + 2) return false;
+        for (std::size_t i = 0; i < h.dof; ++i) {
+          if (h.joint[i].has(rtc::kCalibrating)) return false;
+        }
+        return h.all_calibrated;
+      },
+      to_ns(a.timeout));
+  const rtc::How h = r.session->how();
+  const rtc::Termination t = r.session->release();
+  if (t.ended()) return report_termination(t);
+  if (!done) {
+    fmt::print(stderr, "error: calibration did not finish within {} s\n", a.timeout);
+    return kFailure;
+  }
+  fmt::print("ALL JOINTS calibrated after {:.2f} s\n", h.time_s - before.time_s);
+  print_positions_detailed(r.model, h);
+  return kOk;
+}
+
+// ---------------------------------------------------------------------------------------------
+
+int run_limp(const RtcArgs& a) {
+  SimulatedRobot r(a);
+  r.session->control([](rtc::Control& c) { c.chg().power = rtc::Request::off; }, {});
+  const bool off = r.session->wait_until([](const rtc::How& h) { return !h.power; }, 1s);
+  const rtc::Termination t = r.session->release();
+  if (t.ended()) return report_termination(t);
+  if (!off) {
+    fmt::print(stderr, "error: arm power did not go off\n");
+    return kFailure;
+  }
+  fmt::print("arm power off: the joints are limp (held by their brakes)\n");
+  print_positions(r.model, r.session->how());
+  return kOk;
+}
+
+// ---------------------------------------------------------------------------------------------
+
+struct MarshArgs : RtcArgs {
+  double seconds = 4.0;
+  double every = 0.5;
+  std::vector<std::string> pushes;
+};
+
+int run_marsh(const MarshArgs& a) {
+  struct Push {
+    std::size_t joint;
+    double effort;
+  };
+  SimulatedRobot r(a);
+  std::vector<Push> pushes;
+  for (const std::string& p : a.pushes) {
+    const auto colon = p.find(':');
+    std::size_t joint = 0;
+    double effort = 0;
+    try {
+      joint = std::stoul(p.substr(0, colon));
+      effort = std::stod(p.substr(colon + 1));
+    } catch (const std::exception&) {
+      joint = 0;
+    }
+    if (colon == std::string::npos || joint < 1 || joint > r.model.dof() ||
+        !std::isfinite(effort)) {
+      throw BadArgument{fmt::format(
+          "--push: \"{}\" should be JOINT:EFFORT with JOINT 1..{} and EFFORT in N m (revolute) or "
+          "N (prismatic)",
+          p, r.model.dof())};
+    }
+    pushes.push_back({joint - 1, effort});
+  }
+  if (!pushes.empty() && !r.simulated()) {
+    throw BadArgument{"--push needs simulated time (a hand cannot push a real-time simulation)"};
+  }
+  if (!(a.seconds > 0) || !(a.every > 0)) throw BadArgument{"--seconds and --every must be > 0"};
+
+  std::atomic<bool> finish{false};
+  r.session->control(
+      [&finish](rtc::Control& c) {
+        c.chg().zero_gravity =
+            finish.load(std::memory_order_relaxed) ? rtc::Request::off : rtc::Request::on;
+      },
+      {});
+  fmt::print("zero gravity: the joints follow a push and stay where they are left{}\n",
+             pushes.empty() ? "" : " (pushing for the first half)");
+  const std::int64_t lines = std::max<std::int64_t>(1, std::llround(a.seconds / a.every));
+  for (std::int64_t i = 0; i < lines; ++i) {
+    // Between samples of simulated time the arm is the planning level's to touch.
+    const bool pushing = 2 * i < lines;
+    for (const Push& p : pushes) r.arm->set_external_effort(p.joint, pushing ? p.effort : 0.0);
+    const rtc::Termination t = r.session->wait_for(to_ns(a.every));
+    print_positions(r.model, r.session->how());
+    if (t.ended()) return report_termination(t);
+  }
+  finish = true;
+  r.session->wait_for(r.session->period() * 2);
+  return report_termination(r.session->release());
+}
+
+// ---------------------------------------------------------------------------------------------
+// jointtest: the thesis's `test` program, one command per line on stdin.
+
+struct TestCommand {
+  char letter = 0;
+  std::uint8_t joint = 0;
+  double value = 0.0;  ///< SI: a range value, or a bit number
+  double speed = 0.0;  ///< SI, per second: for m and M
+};
+
+/// What the control task keeps for jointtest: written only in f1 and f2.
+struct ServoRamp {
+  bool active = false;
+  std::size_t joint = 0;
+  double target = 0.0;  ///< range value
+  double speed = 0.0;   ///< per second
+  double at = 0.0;      ///< the last POSVEL target
+};
+
+constexpr const char* kTestMenu =
+    "commands (one per line; values in deg or mm, speeds per second):\n"
+    "  j N     set the joint for the commands below      x    examine positions\n"
+    "  m V     move joint to V at its velocity (POS)     M V  servo joint to V (POSVEL ramp)\n"
+    "  v V     set the joint's velocity                  s    stop joint where it is\n"
+    "  h / H   open / close the hand                     o B / O B  clear / set output bit B\n"
+    "  p / P   arm power off / on                        r MS set the sample period\n"
+    "  w S     wait S seconds                            q    quit\n"
+    "  a f k K V X z: motor parameters of the Microbo's joint controllers (not on this robot)\n"
+    "  ?       this menu\n";
+
+/// Lines from stdin that give up waiting when `stop` is set (Ctrl-C): std::getline would block
+/// on and on, since the session keeps SIGINT from ending the process.
+class LineReader {
+ public:
+  explicit LineReader(const std::atomic<bool>& stop) : stop_(stop) {}
+
+  bool next(std::string& line) {
+    for (;;) {
+      if (const auto nl = buffer_.find('\n'); nl != std::string::npos) {
+        line = buffer_.substr(0, nl);
+        buffer_.erase(0, nl + 1);
+        return true;
+      }
+      if (eof_ || stop_.load()) {
+        if (buffer_.empty() || stop_.load()) return false;
+        line = std::exchange(buffer_, {});
+        return true;
+      }
+      pollfd p{STDIN_FILENO, POLLIN, 0};
+      if (poll(&p, 1, 100) <= 0) continue;  // look at `stop` ten times a second
+      char chunk[4096];
+      const ssize_t n = read(STDIN_FILENO, chunk, sizeof chunk);
+      if (n <= 0) {
+        eof_ = n == 0 || errno != EINTR;
+      } else {
+        buffer_.append(chunk, static_cast<std::size_t>(n));
+      }
+    }
+  }
+
+ private:
+  const std::atomic<bool>& stop_;
+  std::string buffer_;
+  bool eof_ = false;
+};
+
+int run_jointtest(const RtcArgs& a) {
+  SimulatedRobot r(a);
+  const kin::RobotModel& m = r.model;
+  auto queue =
+      std::make_shared<boost::lockfree::spsc_queue<TestCommand, boost::lockfree::capacity<64>>>();
+  auto ramp = std::make_shared<ServoRamp>();
+
+  // The control task's side: commands arrive through a lock-free queue, never a lock.
+  const auto f1 = [queue, ramp](rtc::Control& c) {
+    TestCommand cmd;
+    while (queue->pop(cmd)) {
+      switch (cmd.letter) {
+        case 'm':
+          ramp->active = false;
+          c.chg().pos(cmd.joint, cmd.value, cmd.speed);
+          break;
+        case 'M':
+          *ramp = {true, cmd.joint, cmd.value, cmd.speed, c.how().joint[cmd.joint].range};
+          break;
+        case 's':
+          ramp->active = false;
+          c.chg().pos(cmd.joint, c.how().joint[cmd.joint].range);
+          break;
+        case 'h':
+          c.chg().hand = rtc::Request::off;
+          break;
+        case 'H':
+          c.chg().hand = rtc::Request::on;
+          break;
+        case 'o':
+          c.chg().outputs_clear =
+              static_cast<std::uint16_t>(1U << static_cast<unsigned>(cmd.value));
+          break;
+        case 'O':
+          c.chg().outputs_set = static_cast<std::uint16_t>(1U << static_cast<unsigned>(cmd.value));
+          break;
+        case 'p':
+          c.chg().power = rtc::Request::off;
+          break;
+        case 'P':
+          c.chg().power = rtc::Request::on;
+          break;
+        default:
+          break;
+      }
+    }
+  };
+  // M: POSVEL every sample along a ramp at the joint's velocity.
+  const auto f2 = [ramp](rtc::Control& c) {
+    if (!ramp->active) return;
+    const double step = ramp->speed * c.period_s();
+    ramp->at += std::clamp(ramp->target - ramp->at, -step, step);
+    c.chg().posvel(ramp->joint, ramp->at);
+    if (ramp->at == ramp->target) ramp->active = false;
+  };
+  // Ctrl-C ends the program (the arm holds); without this it would only end control.
+  std::atomic<bool> interrupted{false};
+  r.session->set_hangup_handler([&interrupted](rtc::Session&) { interrupted = true; });
+  const auto start = [&] { r.session->control(f1, f2); };
+  start();
+
+  std::size_t joint = 0;
+  std::vector<double> velocity(m.dof());
+  for (std::size_t i = 0; i < m.dof(); ++i)
+    velocity[i] = rtc::kDefaultSpeedFraction * m.joints[i].max_velocity;
+  const auto send = [&](TestCommand c) {
+    while (!queue->push(c)) r.session->wait_for(r.session->period());
+    r.session->wait_for(r.session->period());  // simulated time: let the command take effect
+  };
+  int status = kOk;
+  const auto check = [&] {
+    const rtc::Termination t = r.session->termination();
+    if (!t.ended()) return;
+    rtc::print_terminate_code(t, stdout);
+    status = kFailure;
+    r.session->release();
+    start();
+    fmt::print("control restarted\n");
+  };
+
+  fmt::print("jointtest on {} ({} joints), {} time, period {:.3f} ms. ? for the menu.\n", m.title,
+             m.dof(), r.simulated() ? "simulated" : "real", r.period_s() * 1e3);
+  std::string line;
+  LineReader input(interrupted);
+  while (input.next(line)) {
+    std::istringstream in(line);
+    std::string word;
+    if (!(in >> word)) continue;
+    const char letter = word[0];
+    double value = 0;
+    const bool has_value = static_cast<bool>(in >> value);
+    const kin::Joint& jm = m.joints[joint];
+    const auto need_value = [&](const char* what) {
+      if (!has_value || !std::isfinite(value)) {
+        fmt::print(stderr, "{}: give {} after the letter, e.g. \"{} 10\"\n", letter, what, letter);
+        return false;
+      }
+      return true;
+    };
+    switch (word.size() == 1 ? letter : '\0') {
+      case 'j':
+        if (need_value("a joint number")) {
+          if (value < 1 || value > static_cast<double>(m.dof())) {
+            fmt::print(stderr, "j: joints are 1 to {}\n", m.dof());
+          } else {
+            joint = static_cast<std::size_t>(value) - 1;
+            fmt::print("joint {} ({})\n", joint + 1, m.joints[joint].name);
+          }
+        }
+        break;
+      case 'v':
+        if (need_value(revolute(jm) ? "a speed in deg/s" : "a speed in mm/s")) {
+          velocity[joint] = std::abs(from_shown(jm, value));
+          fmt::print("joint {} velocity {:.3f} {}/s\n", joint + 1, shown(jm, velocity[joint]),
+                     unit(jm));
+        }
+        break;
+      case 'm':
+        if (need_value(revolute(jm) ? "a position in deg" : "a position in mm")) {
+          send({'m', static_cast<std::uint8_t>(joint), from_shown(jm, value) - jm.lower,
+                velocity[joint]});
+        }
+        break;
+      case 'M':
+        if (need_value(revolute(jm) ? "a position in deg" : "a position in mm")) {
+          send({'M', static_cast<std::uint8_t>(joint), from_shown(jm, value) - jm.lower,
+                velocity[joint]});
+        }
+        break;
+      case 's':
+        send({'s', static_cast<std::uint8_t>(joint), 0, 0});
+        break;
+      case 'h':
+      case 'H':
+      case 'p':
+      case 'P':
+        send({letter, 0, 0, 0});
+        break;
+      case 'o':
+      case 'O':
+        if (need_value("a bit number 0..15")) {
+          if (value < 0 || value > 15) {
+            fmt::print(stderr, "{}: output bits are 0 to 15\n", letter);
+          } else {
+            send({letter, 0, std::floor(value), 0});
+          }
+        }
+        break;
+      case 'x':
+        print_positions_detailed(m, r.session->how());
+        break;
+      case 'w':
+        if (need_value("a time in seconds")) r.session->wait_for(to_ns(std::max(0.0, value)));
+        break;
+      case 'r':
+        if (need_value("a period in ms")) {
+          try {
+            const auto p = parse_period(fmt::format("{}ms", value));
+            r.session->release();
+            r.session->set_period(p);
+            start();
+            fmt::print("sample period {:.3f} ms\n", r.period_s() * 1e3);
+          } catch (const BadArgument& e) {
+            fmt::print(stderr, "r: {}\n", e.message);
+          }
+        }
+        break;
+      case 'a':
+      case 'f':
+      case 'k':
+      case 'K':
+      case 'V':
+      case 'X':
+      case 'z':
+        fmt::print(
+            "{}: motor parameters belong to the Microbo's joint controllers (thesis "
+            "Appendix B); {} has none\n",
+            letter, m.name);
+        break;
+      case 'q':
+        check();
+        r.session->release();
+        return status;
+      case '?':
+        fmt::print("{}", kTestMenu);
+        break;
+      default:
+        fmt::print(stderr, "unknown command \"{}\": type ? for the menu\n", word);
+        break;
+    }
+    check();
+  }
+  r.session->release();
+  if (interrupted) {
+    fmt::print("interrupted: control released, the arm holds\n");
+    return kFailure;
+  }
+  return status;
+}
+
+}  // namespace
+
+void add_rtc_commands(CLI::App& app, int& exit_code) {
+  const char* robot_note =
+      " Runs on a simulated robot (rccx::hw): the PUMA 560/260 with PID joint servos, any other "
+      "robot file with an ideal servo.";
+
+  auto report = std::make_shared<ReportArgs>();
+  CLI::App* report_cmd = app.add_subcommand(
+      "report", std::string("Report joint positions (deg, mm) every --every seconds (thesis "
+                            "report.c); with --realtime also the wake-up latency of the "
+                            "communication task.") +
+                    robot_note);
+  add_rtc_options(*report_cmd, *report);
+  report_cmd->add_option("--seconds", report->seconds, "How long to run, s")->capture_default_str();
+  report_cmd->add_option("--every", report->every, "Seconds between reports")
+      ->capture_default_str();
+  report_cmd->add_flag("--json", report->json, "Print only the latency figures, as JSON");
+  report_cmd->callback(
+      [report, &exit_code] { guarded(exit_code, [&] { return run_report(*report); }); });
+
+  auto calib = std::make_shared<CalibArgs>();
+  CLI::App* calib_cmd = app.add_subcommand(
+      "calib",
+      std::string("Calibrate every joint (STOPCAL) and wait for ALL JOINTS (thesis calib.c).") +
+          robot_note);
+  add_rtc_options(*calib_cmd, *calib);
+  calib_cmd->add_option("--timeout", calib->timeout, "Give up after this long, s")
+      ->capture_default_str();
+  calib_cmd->callback(
+      [calib, &exit_code] { guarded(exit_code, [&] { return run_calib(*calib); }); });
+
+  auto limp = std::make_shared<RtcArgs>();
+  CLI::App* limp_cmd =
+      app.add_subcommand("limp", std::string("Turn arm power off (thesis limp.c).") + robot_note);
+  add_rtc_options(*limp_cmd, *limp);
+  limp_cmd->callback([limp, &exit_code] { guarded(exit_code, [&] { return run_limp(*limp); }); });
+
+  auto marsh = std::make_shared<MarshArgs>();
+  CLI::App* marsh_cmd = app.add_subcommand(
+      "marsh", std::string("Zero gravity: the joints follow a push and stay (thesis marsh.c).") +
+                   robot_note);
+  add_rtc_options(*marsh_cmd, *marsh);
+  marsh_cmd->add_option("--seconds", marsh->seconds, "How long to run, s")->capture_default_str();
+  marsh_cmd->add_option("--every", marsh->every, "Seconds between reports")->capture_default_str();
+  marsh_cmd->add_option("--push", marsh->pushes,
+                        "JOINT:EFFORT - a simulated hand pushes joint JOINT (1-based) with EFFORT "
+                        "N m or N for the first half of the run; repeatable");
+  marsh_cmd->callback(
+      [marsh, &exit_code] { guarded(exit_code, [&] { return run_marsh(*marsh); }); });
+
+  auto test = std::make_shared<RtcArgs>();
+  CLI::App* test_cmd = app.add_subcommand(
+      "jointtest",
+      std::string("Command single joints through Chg, one command per line on stdin, with the "
+                  "letters of the thesis's test program (? lists them; w S waits S seconds).") +
+          robot_note);
+  add_rtc_options(*test_cmd, *test);
+  test_cmd->callback(
+      [test, &exit_code] { guarded(exit_code, [&] { return run_jointtest(*test); }); });
+
+  CLI::App* codes_cmd =
+      app.add_subcommand("codes", "List RTC's terminate codes and their meanings");
+  codes_cmd->callback([&exit_code] {
+    rtc::print_terminate_codes(stdout);
+    exit_code = kOk;
+  });
+}
+
+}  // namespace rccx::tools
