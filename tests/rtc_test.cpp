@@ -398,6 +398,8 @@ TEST(RtcLimits, ObservedPositionOutOfRangeEndsTheSession) {
   EXPECT_EQ(t.joint, 1);
   EXPECT_TRUE(r.session.how().joint[0].has(rtc::kObservedPositionOut));
   EXPECT_GT(r.arm->true_position()[0], r.model.joints[0].upper);
+  // The push goes on, but the arm left zero gravity and holds against it.
+  expect_holds(r);
 }
 
 TEST(RtcLimits, ObservedVelocityOutOfRangeEndsTheSession) {
@@ -409,6 +411,7 @@ TEST(RtcLimits, ObservedVelocityOutOfRangeEndsTheSession) {
   ASSERT_EQ(t.code, TerminateCode::observed_velocity);
   EXPECT_EQ(t.joint, 1);
   EXPECT_TRUE(r.session.how().joint[0].has(rtc::kObservedVelocityOut));
+  expect_holds(r);
 }
 
 TEST(RtcLimits, UncheckedObservedLimitsOnlySetFlags) {

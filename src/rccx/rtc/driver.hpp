@@ -37,7 +37,7 @@ class Driver {
   virtual void read(double t_s, How& how) noexcept = 0;
   /// Sends this sample's commands (entries of kind none are skipped).
   virtual void send(const JointCommands& commands) noexcept = 0;
-  /// Every joint stops where it is and stays.
+  /// Every joint stops where it is and stays (leaving zero gravity if it was on).
   virtual void hold() noexcept = 0;
   /// Arm power; false when it could not be switched (power failure).
   virtual bool set_power(bool on) noexcept = 0;

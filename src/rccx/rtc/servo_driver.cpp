@@ -72,6 +72,7 @@ void ServoDriver::send(const JointCommands& commands) noexcept {
 }
 
 void ServoDriver::hold() noexcept {
+  arm_.set_zero_gravity(false);  // a yielding arm does not hold: stiffen the servo first
   for (std::size_t i = 0; i < arm_.dof(); ++i) arm_.command(i, {});
 }
 
