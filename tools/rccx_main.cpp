@@ -4,6 +4,7 @@
 #include <CLI/CLI.hpp>
 
 #include "kin_command.hpp"
+#include "rcu_command.hpp"
 #include "rtc_commands.hpp"
 
 int main(int argc, char** argv) {
@@ -15,6 +16,7 @@ int main(int argc, char** argv) {
   int exit_code = rccx::tools::kOk;
   rccx::tools::add_kin_command(app, exit_code);
   rccx::tools::add_rtc_commands(app, exit_code);
+  rccx::tools::add_rcu_command(app, exit_code);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -17,8 +17,10 @@
 #include <utility>
 #include <vector>
 
+#include "rccx/hw/rcu.hpp"
 #include "rccx/hw/simulated_arm.hpp"
 #include "rccx/math/units.hpp"
+#include "rccx/rtc/microbo_driver.hpp"
 #include "rccx/rtc/servo_driver.hpp"
 #include "rccx/rtc/session.hpp"
 
@@ -61,16 +63,17 @@ std::chrono::nanoseconds parse_period(const std::string& text) {
 
 /// What every control program takes.
 struct RtcArgs {
-  RobotChoice robot{"puma560"};
-  std::string period = "10ms";
+  RobotChoice robot{"microbo"};
+  std::string period;  ///< empty: the robot's usual period
   bool realtime = false;
   bool uncalibrated = false;
 };
 
 void add_rtc_options(CLI::App& cmd, RtcArgs& a) {
   add_robot_options(cmd, a.robot);
-  cmd.add_option("--period", a.period, "Sample period: 0.25ms to 56ms (e.g. 1ms, 28ms)")
-      ->capture_default_str();
+  cmd.add_option("--period", a.period,
+                 "Sample period, 0.25ms to 56ms (e.g. 1ms, 28ms); default 28ms for the Microbo "
+                 "(its bus needs about 10 ms a sample), 10ms for the others");
   cmd.add_flag("--realtime", a.realtime,
                "Run in real time (SCHED_FIFO when allowed) instead of simulated time, which is "
                "deterministic and runs as fast as the machine allows");
@@ -78,29 +81,49 @@ void add_rtc_options(CLI::App& cmd, RtcArgs& a) {
                "Start the simulated robot uncalibrated (encoders relative to power-up)");
 }
 
-/// A simulated robot below the wire and an RTC session on it.
+/// A simulated robot below the wire and an RTC session on it: the Microbo's emulated RCU
+/// behind its bus and register-level driver when the robot file describes an RCU, else a
+/// servo arm (the PUMA's PID servos, or the ideal servo).
 struct SimulatedRobot {
   kin::RobotModel model;
   std::unique_ptr<hw::SimulatedArm> arm;
-  std::unique_ptr<rtc::ServoDriver> driver;
+  std::unique_ptr<hw::Rcu> rcu;
+  std::unique_ptr<hw::RcuBus> bus;
+  std::unique_ptr<rtc::Driver> driver;
   std::unique_ptr<rtc::Session> session;
 
   explicit SimulatedRobot(const RtcArgs& a) : model(a.robot.model()) {
-    rtc::SessionOptions options;
-    options.period = parse_period(a.period);
-    options.clock = a.realtime ? rtc::ClockKind::real_time : rtc::ClockKind::simulated;
     hw::SimulatedArmOptions arm_options;
     arm_options.calibrated = !a.uncalibrated;
     try {
-      arm = hw::make_simulated_arm(model, arm_options);
+      if (!model.hardware_json.empty()) {
+        rcu = std::make_unique<hw::Rcu>(model, arm_options);
+        bus = std::make_unique<hw::RcuBus>(*rcu);
+        rtc::MicroboDriverOptions o;
+        for (std::size_t j = 0; j < model.dof(); ++j) o.work_areas[j] = rcu->work_area(j);
+        driver = std::make_unique<rtc::MicroboDriver>(model, *bus, *rcu, o);
+      } else {
+        arm = hw::make_simulated_arm(model, arm_options);
+        driver = std::make_unique<rtc::ServoDriver>(*arm);
+      }
     } catch (const std::invalid_argument& e) {
       throw BadArgument{fmt::format("robot {} cannot be simulated: {}", model.name, e.what())};
     }
-    driver = std::make_unique<rtc::ServoDriver>(*arm);
+    rtc::SessionOptions options;
+    options.period = parse_period(a.period.empty() ? (rcu ? "28ms" : "10ms") : a.period);
+    options.clock = a.realtime ? rtc::ClockKind::real_time : rtc::ClockKind::simulated;
     session = std::make_unique<rtc::Session>(*driver, options);
   }
   [[nodiscard]] bool simulated() const { return session->clock() == rtc::ClockKind::simulated; }
   [[nodiscard]] double period_s() const { return Seconds(session->period()).count(); }
+  /// A simulated hand pushes a joint (N m or N); only between samples of simulated time.
+  void push(std::size_t joint, double effort) {
+    if (rcu) {
+      rcu->set_external_effort(joint, effort);
+    } else {
+      arm->set_external_effort(joint, effort);
+    }
+  }
 };
 
 bool revolute(const kin::Joint& j) {
@@ -310,7 +333,7 @@ int run_marsh(const MarshArgs& a) {
   for (std::int64_t i = 0; i < lines; ++i) {
     // Between samples of simulated time the arm is the planning level's to touch.
     const bool pushing = 2 * i < lines;
-    for (const Push& p : pushes) r.arm->set_external_effort(p.joint, pushing ? p.effort : 0.0);
+    for (const Push& p : pushes) r.push(p.joint, pushing ? p.effort : 0.0);
     const rtc::Termination t = r.session->wait_for(to_ns(a.every));
     print_positions(r.model, r.session->how());
     if (t.ended()) return report_termination(t);
@@ -339,6 +362,28 @@ struct ServoRamp {
   double at = 0.0;      ///< the last POSVEL target
 };
 
+/// The test program's letters for joint controller settings.
+rtc::Setting setting_of(char letter) noexcept {
+  switch (letter) {
+    case 'a':
+      return rtc::Setting::acceleration;
+    case 'f':
+      return rtc::Setting::speed_factor;
+    case 'k':
+      return rtc::Setting::dynamic_integral;
+    case 'K':
+      return rtc::Setting::static_integral;
+    case 'V':
+      return rtc::Setting::static_speed;
+    case 'z':
+      return rtc::Setting::static_zone;
+    case 'X':
+      return rtc::Setting::examine;
+    default:
+      return rtc::Setting::none;
+  }
+}
+
 constexpr const char* kTestMenu =
     "commands (one per line; values in deg or mm, speeds per second):\n"
     "  j N     set the joint for the commands below      x    examine positions\n"
@@ -347,7 +392,11 @@ constexpr const char* kTestMenu =
     "  h / H   open / close the hand                     o B / O B  clear / set output bit B\n"
     "  p / P   arm power off / on                        r MS set the sample period\n"
     "  w S     wait S seconds                            q    quit\n"
-    "  a f k K V X z: motor parameters of the Microbo's joint controllers (not on this robot)\n"
+    "  Microbo joint controllers (Appendix B units):\n"
+    "  a N     acceleration setting (1/4 rad/s^2)       f N  speed factor (0..255)\n"
+    "  k N     dynamic integration constant (0..255)    K N  static integration constant\n"
+    "  V N     static zone speed (0..255)               z N  static zone size (0..255)\n"
+    "  X       examine the joint's motor parameters\n"
     "  ?       this menu\n";
 
 /// Lines from stdin that give up waiting when `stop` is set (Ctrl-C): std::getline would block
@@ -429,6 +478,9 @@ int run_jointtest(const RtcArgs& a) {
           c.chg().power = rtc::Request::on;
           break;
         default:
+          if (const rtc::Setting s = setting_of(cmd.letter); s != rtc::Setting::none) {
+            c.chg().setting = {s, cmd.joint, static_cast<std::uint16_t>(cmd.value)};
+          }
           break;
       }
     }
@@ -558,13 +610,38 @@ int run_jointtest(const RtcArgs& a) {
       case 'k':
       case 'K':
       case 'V':
-      case 'X':
       case 'z':
-        fmt::print(
-            "{}: motor parameters belong to the Microbo's joint controllers (thesis "
-            "Appendix B); {} has none\n",
-            letter, m.name);
+      case 'X': {
+        if (!r.rcu) {
+          fmt::print("{}: {} has no Microbo joint controllers (thesis Appendix B)\n", letter,
+                     m.name);
+          break;
+        }
+        const double limit = letter == 'a' ? 65535 : 255;
+        if (letter != 'X' && need_value("a value in the controller's units")) {
+          if (value < 0 || value > limit) {
+            fmt::print(stderr, "{}: the value must be 0 to {}\n", letter, limit);
+            break;
+          }
+        } else if (letter != 'X') {
+          break;
+        }
+        send({letter, static_cast<std::uint8_t>(joint), std::floor(value), 0});
+        if (letter == 'X') {
+          r.session->wait_for(r.session->period());  // read during the next sample
+          const rtc::How h = r.session->how();
+          if (h.examined_joint != static_cast<int>(joint)) {
+            fmt::print(stderr, "X: joint {} did not answer\n", joint + 1);
+            break;
+          }
+          fmt::print("joint {} motor parameters:", joint + 1);
+          for (const std::uint8_t b : h.motor_parameters) fmt::print(" {}", b);
+          fmt::print("\n");
+        } else {
+          fmt::print("joint {} {} {}\n", joint + 1, rtc::to_string(setting_of(letter)), value);
+        }
         break;
+      }
       case 'q':
         check();
         r.session->release();
@@ -590,8 +667,9 @@ int run_jointtest(const RtcArgs& a) {
 
 void add_rtc_commands(CLI::App& app, int& exit_code) {
   const char* robot_note =
-      " Runs on a simulated robot (rccx::hw): the PUMA 560/260 with PID joint servos, any other "
-      "robot file with an ideal servo.";
+      " Runs on a simulated robot (rccx::hw): the Microbo (default) through its emulated RCU, "
+      "registers and bus; the PUMA 560/260 with PID joint servos; any other robot file with an "
+      "ideal servo.";
 
   auto report = std::make_shared<ReportArgs>();
   CLI::App* report_cmd = app.add_subcommand(

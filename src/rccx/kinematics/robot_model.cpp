@@ -237,6 +237,12 @@ RobotModel parse_robot(std::string_view json_text, std::string_view origin) {
     model.joints.push_back(parse_joint(joints[i], fmt::format("{}: joint {}", origin, i + 1)));
   }
   r.has("notes");
+  if (r.has("hardware")) {
+    // What lies below the wire belongs to rccx::hw, which reads it with its own checks.
+    const json& hardware = r.get("hardware");
+    if (!hardware.is_object()) r.fail("\"hardware\" must be an object");
+    model.hardware_json = hardware.dump();
+  }
   r.no_unknown_keys();
   return model;
 }

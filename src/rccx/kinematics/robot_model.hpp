@@ -59,6 +59,9 @@ struct RobotModel {
   std::string source;  ///< where the numbers come from
   SolverKind solver = SolverKind::dh;
   std::vector<Joint> joints;
+  /// The file's "hardware" object as JSON text (empty when none): what a simulator of this
+  /// robot's controller needs (the Microbo's RCU), parsed and checked by rccx::hw.
+  std::string hardware_json;
 
   [[nodiscard]] std::size_t dof() const noexcept { return joints.size(); }
   [[nodiscard]] JointVector ready() const noexcept;

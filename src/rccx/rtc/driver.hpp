@@ -6,6 +6,7 @@
 
 #include <array>
 #include <cstdint>
+#include <string_view>
 
 #include "rccx/kinematics/robot_model.hpp"
 #include "rccx/rtc/types.hpp"
@@ -32,13 +33,32 @@ class Driver {
   [[nodiscard]] virtual const kin::RobotModel& model() const noexcept = 0;
 
   /// Reads the arm at time t_s (s since the session opened) into `how`: for each joint q,
-  /// velocity and the flags kCalibrated, kCalibrating, kNotAnswering, kEncoderError; and
-  /// power, hand_closed, outputs. Range values and limit flags are the caller's.
+  /// velocity and the flags kCalibrated, kCalibrating, kNotAnswering, kEncoderError,
+  /// kPhaseError, kJointFault; and power, hand_closed, outputs. Range values and limit flags
+  /// are the caller's.
   virtual void read(double t_s, How& how) noexcept = 0;
   /// Sends this sample's commands (entries of kind none are skipped).
   virtual void send(const JointCommands& commands) noexcept = 0;
   /// Every joint stops where it is and stays (leaving zero gravity if it was on).
   virtual void hold() noexcept = 0;
+  /// The fastest joint `joint` may be commanded at a sample period of `period_s`, rad/s or m/s:
+  /// the model's top speed, or less where the driver needs it (the Microbo's work areas).
+  [[nodiscard]] virtual double velocity_limit(std::size_t joint, double period_s) const noexcept {
+    (void)period_s;
+    return model().joints[joint].max_velocity;
+  }
+  /// What went wrong with a joint the last read flagged (e.g. "TIMEOUT_GET"); may be empty.
+  [[nodiscard]] virtual std::string_view fault_detail(std::size_t joint) const noexcept {
+    (void)joint;
+    return {};
+  }
+  /// Applies a joint controller setting (Setting::examine: reads the joint's motor parameters
+  /// into how.motor_parameters at the next read). False when this robot's controllers have no
+  /// such setting.
+  virtual bool apply(const SettingChg& setting) noexcept {
+    (void)setting;
+    return false;
+  }
   /// Arm power; false when it could not be switched (power failure).
   virtual bool set_power(bool on) noexcept = 0;
   virtual void set_hand_closed(bool closed) noexcept = 0;

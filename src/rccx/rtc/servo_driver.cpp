@@ -9,44 +9,28 @@ void ServoDriver::read(double t_s, How& how) noexcept {
   const auto& joints = arm_.model().joints;
   const std::size_t n = joints.size();
   how.dof = static_cast<std::uint8_t>(n);
-
-  Sample& now = history_[reads_ % kHistory];
-  const Sample* before = reads_ > 0 ? &history_[(reads_ - 1) % kHistory] : nullptr;
-  now.t_s = t_s;
-  now.q = JointVector(n);
+  JointVector q(n);
   bool all_calibrated = true;
   for (std::size_t i = 0; i < n; ++i) {
     const hw::JointReading r = arm_.read(i);
     std::uint16_t flags = 0;
     if (!r.answered) {
       flags |= kNotAnswering;
-      now.q[i] = before ? before->q[i] : how.joint[i].q;  // keep the last known value
+      q[i] = how.joint[i].q;  // keep the last known value
     } else {
-      now.q[i] = static_cast<double>(r.counts) * joints[i].resolution_per_count;
+      q[i] = static_cast<double>(r.counts) * joints[i].resolution_per_count;
       if (r.encoder_error) flags |= kEncoderError;
     }
     if (r.calibrated) flags |= kCalibrated;
-    // Calibration makes the counts absolute: the jump is not motion, so the speed starts over.
-    if (before && r.calibrated != ((how.joint[i].flags & kCalibrated) != 0)) {
-      for (Sample& old : history_) old.q[i] = now.q[i];
-    }
     if (r.calibrating) flags |= kCalibrating;
+    // Calibration makes the counts absolute: the jump is not motion, so the speed starts over.
+    if (reads_ > 0 && r.calibrated != how.joint[i].has(kCalibrated)) velocity_.restart(i, q[i]);
     all_calibrated = all_calibrated && r.calibrated;
-    how.joint[i].q = now.q[i];
+    how.joint[i].q = q[i];
     how.joint[i].flags = flags;
   }
-
-  // Speed over the newest sample at least a window old (or the oldest kept).
-  const Sample* old = nullptr;
-  const std::size_t kept = std::min(reads_, kHistory - 1);
-  for (std::size_t back = 1; back <= kept; ++back) {
-    old = &history_[(reads_ - back) % kHistory];
-    if (t_s - old->t_s >= kVelocityWindow_s) break;
-  }
-  const double dt = old ? t_s - old->t_s : 0.0;
-  for (std::size_t i = 0; i < n; ++i) {
-    how.joint[i].velocity = dt > 0.0 ? (now.q[i] - old->q[i]) / dt : 0.0;
-  }
+  const JointVector v = velocity_.update(t_s, q);
+  for (std::size_t i = 0; i < n; ++i) how.joint[i].velocity = v[i];
   ++reads_;
 
   how.all_calibrated = all_calibrated;

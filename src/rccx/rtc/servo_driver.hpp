@@ -1,6 +1,6 @@
 // The Driver for rccx::hw's simulated servo arms (the PUMA with its PID servos, the ideal arm
-// for any model): encoder counts to joint values, speed from encoder differences over a
-// window, commands to servo goals. The arm is advanced to the sample time on each read, so it
+// for any model): encoder counts to joint values, speeds from encoder differences, commands to
+// servo goals. The arm is advanced to the sample time on each read, so it
 // runs in simulated time and real time alike.
 #pragma once
 
@@ -9,6 +9,7 @@
 
 #include "rccx/hw/simulated_arm.hpp"
 #include "rccx/rtc/driver.hpp"
+#include "rccx/rtc/velocity_estimator.hpp"
 
 namespace rccx::rtc {
 
@@ -29,18 +30,8 @@ class ServoDriver final : public Driver {
   [[nodiscard]] hw::SimulatedArm& arm() noexcept { return arm_; }
 
  private:
-  /// Speeds are encoder differences over at least this long, so that one count of
-  /// quantisation is a small speed even at a 0.25 ms period.
-  static constexpr double kVelocityWindow_s = 0.010;
-  static constexpr std::size_t kHistory = 64;
-
-  struct Sample {
-    double t_s = 0.0;
-    JointVector q;
-  };
-
   hw::SimulatedArm& arm_;
-  std::array<Sample, kHistory> history_{};
+  VelocityEstimator velocity_;
   std::size_t reads_ = 0;
 };
 

@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cstring>
 #include <mutex>
+#include <utility>
 
 #include "rccx/kinematics/kinematics.hpp"
 #include "rccx/rtc/hangup.hpp"
@@ -36,7 +37,7 @@ enum Pending : std::uint32_t { kPendingHold = 1, kPendingPowerOff = 2 };
 template <std::size_t N>
 void copy_text(std::array<char, N>& to, std::string_view text) noexcept {
   const std::size_t n = std::min(text.size(), N - 1);
-  std::memcpy(to.data(), text.data(), n);
+  if (n > 0) std::memcpy(to.data(), text.data(), n);  // an empty view may hold no pointer
   to[n] = '\0';
 }
 
@@ -535,22 +536,30 @@ void Session::controlled_cycle(CommState& c) noexcept {
     }
   }
 
-  for (std::size_t i = 0; i < h.dof; ++i) {
-    const int joint = static_cast<int>(i) + 1;
-    if (h.joint[i].has(kNotAnswering)) {
-      return end_control(c, TerminateCode::joint_not_answering, joint, "");
-    }
-    if (h.joint[i].has(kEncoderError))
-      return end_control(c, TerminateCode::encoder_error, joint, "");
-  }
+  // Power first: losing it makes every joint report a fault.
   if (c.power_expected && !h.power) {
     return end_control(c, TerminateCode::power_failure, 0, "arm power went off");
   }
+  static constexpr std::pair<JointFlag, TerminateCode> kFaults[] = {
+      {kNotAnswering, TerminateCode::joint_not_answering},
+      {kEncoderError, TerminateCode::encoder_error},
+      {kPhaseError, TerminateCode::phase_error},
+      {kJointFault, TerminateCode::joint_fault},
+  };
+  for (std::size_t i = 0; i < h.dof; ++i) {
+    for (const auto& [flag, code] : kFaults) {
+      if (h.joint[i].has(flag)) {
+        return end_control(c, code, static_cast<int>(i) + 1, driver_.fault_detail(i));
+      }
+    }
+  }
 
-  // Observed limits, for calibrated joints (an uncalibrated position means nothing yet).
+  // Observed limits.
   for (std::size_t i = 0; i < h.dof; ++i) {
     JointHow& j = h.joint[i];
-    if (!j.has(kCalibrated)) continue;
+    // Only calibrated joints: an uncalibrated position means nothing yet, and a calibrating
+    // joint may stand on its mechanical stop, outside its range.
+    if (!j.has(kCalibrated) || j.has(kCalibrating)) continue;
     const kin::Joint& m = joints[i];
     const double position_slack = 2.0 * m.resolution_per_count;  // quantisation at a hard stop
     if (!(j.q >= m.lower - position_slack && j.q <= m.upper + position_slack)) {
@@ -563,13 +572,14 @@ void Session::controlled_cycle(CommState& c) noexcept {
       }
     }
     // Speeds come from encoder differences: allow their quantisation and a little overshoot.
-    const double speed_slack = 0.05 * m.max_velocity + 2.0 * m.resolution_per_count / 0.010;
-    if (std::abs(j.velocity) > m.max_velocity + speed_slack) {
+    const double top = driver_.velocity_limit(i, static_cast<double>(period) * 1e-9);
+    const double speed_slack = 0.05 * top + 2.0 * m.resolution_per_count / 0.010;
+    if (std::abs(j.velocity) > top + speed_slack) {
       j.flags |= kObservedVelocityOut;
       if ((c.chg.checking & kCheckObservedVelocity) != 0) {
         std::array<char, kMessageCapacity> d;
         format_text(d, "joint {} measured at {:.4f} {}/s, maximum {:.4f}", i + 1, j.velocity,
-                    unit_of(m), m.max_velocity);
+                    unit_of(m), top);
         return end_control(c, TerminateCode::observed_velocity, static_cast<int>(i) + 1, d.data());
       }
     }
@@ -619,6 +629,7 @@ void Session::apply(CommState& c, const Chg& chg) noexcept {
   }
   if (chg.hand != Request::none) driver_.set_hand_closed(chg.hand == Request::on);
   if (chg.zero_gravity != Request::none) driver_.set_zero_gravity(chg.zero_gravity == Request::on);
+  if (chg.setting.what != Setting::none && chg.setting.joint < h.dof) driver_.apply(chg.setting);
   if (chg.outputs_set != 0 || chg.outputs_clear != 0) {
     driver_.set_outputs(
         static_cast<std::uint16_t>((h.outputs | chg.outputs_set) & ~chg.outputs_clear));
@@ -653,19 +664,19 @@ void Session::apply(CommState& c, const Chg& chg) noexcept {
       target = std::clamp(target, joint.lower, joint.upper);  // never sent outside the limits
     }
     const double from = c.has_target[i] ? c.last_target[i] : j.q;
-    double rate =
-        m.set == SetMode::posvel
-            ? std::abs(target - from) / period_s
-            : (m.velocity > 0.0 ? m.velocity : kDefaultSpeedFraction * joint.max_velocity);
-    if (!(rate <= joint.max_velocity * (1.0 + 1e-9))) {
+    const double top = driver_.velocity_limit(i, period_s);  // at most the model's top speed
+    double rate = m.set == SetMode::posvel
+                      ? std::abs(target - from) / period_s
+                      : (m.velocity > 0.0 ? m.velocity : kDefaultSpeedFraction * top);
+    if (!(rate <= top * (1.0 + 1e-9))) {
       j.flags |= kTargetVelocityOut;
       if ((chg.checking & kCheckTargetVelocity) != 0 || !std::isfinite(rate)) {
         std::array<char, kMessageCapacity> d;
         format_text(d, "joint {} commanded at {:.4f} {}/s, maximum {:.4f}", number, rate,
-                    unit_of(joint), joint.max_velocity);
+                    unit_of(joint), top);
         return end_control(c, TerminateCode::target_velocity, number, d.data());
       }
-      rate = joint.max_velocity;  // arrives late rather than too fast
+      rate = top;  // arrives late rather than too fast
     }
     commands[i] = {JointCommand::Kind::move, target, rate};
     c.last_target[i] = target;

@@ -20,6 +20,28 @@ std::string_view to_string(SetMode m) noexcept {
   return "?";
 }
 
+std::string_view to_string(Setting s) noexcept {
+  switch (s) {
+    case Setting::none:
+      return "none";
+    case Setting::acceleration:
+      return "acceleration";
+    case Setting::speed_factor:
+      return "speed factor";
+    case Setting::dynamic_integral:
+      return "dynamic integral";
+    case Setting::static_integral:
+      return "static integral";
+    case Setting::static_speed:
+      return "static speed";
+    case Setting::static_zone:
+      return "static zone";
+    case Setting::examine:
+      return "examine";
+  }
+  return "?";
+}
+
 namespace {
 template <class F>
 JointVector per_joint(const How& h, F f) noexcept {
@@ -76,6 +98,10 @@ constexpr CodeInfo kCodes[] = {
      "a joint controller stopped answering; arm power was turned off"},
     {TerminateCode::encoder_error, "encoder_error", "a joint's encoder reported an error"},
     {TerminateCode::power_failure, "power_failure", "arm power was lost or could not be turned on"},
+    {TerminateCode::phase_error, "phase_error",
+     "a joint's encoder reported a phase error (both channels switched at once)"},
+    {TerminateCode::joint_fault, "joint_fault",
+     "a joint controller reported a fault during motion (following error or overheating)"},
 };
 
 const CodeInfo* info(TerminateCode code) noexcept {

@@ -44,6 +44,26 @@ enum Check : std::uint8_t {
 
 enum class Request : std::uint8_t { none, on, off };
 
+/// A joint controller setting (the Microbo's, Appendix B; the thesis's `test` program letters).
+/// Values are the controller's own units, as the registers take them.
+enum class Setting : std::uint8_t {
+  none,
+  acceleration,      ///< a: SET MAXIMUM ACCELERATION (1/4 rad/s^2 of the motor)
+  speed_factor,      ///< f: WRITE SPEED FACTOR (0..255)
+  dynamic_integral,  ///< k: motor parameter 6, dynamic integration constant (0..255)
+  static_integral,   ///< K: motor parameter 7, static integration constant (0..255)
+  static_speed,      ///< V: motor parameter 8, static zone speed (0..255)
+  static_zone,       ///< z: motor parameter 4, size of the static regulation zone (0..255)
+  examine,           ///< X: read the joint's 16 motor parameters into How
+};
+std::string_view to_string(Setting s) noexcept;
+
+struct SettingChg {
+  Setting what = Setting::none;
+  std::uint8_t joint = 0;  ///< 0-based
+  std::uint16_t value = 0;
+};
+
 /// The command vehicle: written by the control functions, handed to the communication task
 /// once per sample (after f1). Commands are one-shot (cleared after each hand-over); the
 /// checking mode stays as set.
@@ -55,6 +75,7 @@ struct Chg {
   Request zero_gravity = Request::none;  ///< on: the joints yield to a push and stay ("marsh")
   std::uint16_t outputs_set = 0;         ///< output bits to set this sample
   std::uint16_t outputs_clear = 0;       ///< output bits to clear this sample
+  SettingChg setting;                    ///< one controller setting per sample
 
   /// Conveniences; `joint` is 0-based.
   void pos(std::size_t joint, double range_target, double velocity = 0.0) noexcept {
@@ -83,6 +104,8 @@ enum JointFlag : std::uint16_t {
   kObservedVelocityOut = 1U << 6,  ///< measured speed above the joint's maximum
   kTargetVelocityOut = 1U << 7,    ///< a commanded speed above the joint's maximum (not sent)
   kNotCalibratedTarget = 1U << 8,  ///< a position target for a joint that is not calibrated
+  kPhaseError = 1U << 9,           ///< the joint's encoder channels switched at once
+  kJointFault = 1U << 10,          ///< the joint's controller reports a fault (following error)
 };
 
 struct JointHow {
@@ -103,6 +126,10 @@ struct How {
   bool hand_closed = false;
   bool all_calibrated = false;  ///< every joint calibrated (the thesis's "ALL JOINTS")
   std::uint16_t outputs = 0;    ///< the output bits as they stand
+  /// The motor parameters of the joint last examined (Setting::examine), as its controller
+  /// holds them; examined_joint is 0-based, -1 before any.
+  std::int8_t examined_joint = -1;
+  std::array<std::uint8_t, 16> motor_parameters{};
 
   [[nodiscard]] JointVector q() const noexcept;
   [[nodiscard]] JointVector range() const noexcept;
@@ -126,6 +153,8 @@ enum class TerminateCode : std::int32_t {
   joint_not_answering = 30,  ///< a joint's controller stopped answering (arm powered down)
   encoder_error = 31,        ///< a joint's encoder failed
   power_failure = 32,        ///< arm power was lost (or could not be turned on)
+  phase_error = 33,          ///< a joint's encoder reported a phase error
+  joint_fault = 34,          ///< a joint's controller reported a fault during motion
 };
 
 /// What each code means, one line, for people.
