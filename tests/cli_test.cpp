@@ -185,6 +185,16 @@ CliRun rccx_cli_with_input(const std::string& arguments, const std::string& inpu
   return run;
 }
 
+/// Every value printed after " NAME " (the control programs' position lines), in order.
+std::vector<double> values_of(const std::string& out, const std::string& name) {
+  std::vector<double> values;
+  const std::string key = " " + name + " ";
+  for (std::size_t at = out.find(key); at != std::string::npos; at = out.find(key, at + 1)) {
+    values.push_back(std::stod(out.substr(at + key.size())));
+  }
+  return values;
+}
+
 /// The value printed after "NAME " on the last line that has it (report's position lines).
 double last_value_of(const std::string& out, const std::string& name) {
   const auto at = out.rfind(" " + name + " ");
@@ -235,12 +245,7 @@ TEST(CliRtc, MarshLetsAPushedJointMoveAndStay) {
   const CliRun run = rccx_cli("marsh --robot puma560 --seconds 2 --every 0.5 --push 1:40");
   ASSERT_EQ(run.exit_code, 0) << run.out;
   // Four position lines: two while pushed, two after. Joint 1 moved up and then stayed.
-  std::vector<double> theta1;
-  std::size_t at = 0;
-  while ((at = run.out.find(" theta1 ", at)) != std::string::npos) {
-    theta1.push_back(std::stod(run.out.substr(at + 8)));
-    at += 8;
-  }
+  const std::vector<double> theta1 = values_of(run.out, "theta1");
   ASSERT_EQ(theta1.size(), 4U) << run.out;
   EXPECT_GT(theta1[1], theta1[0]) << "joint 1 did not follow the push";
   EXPECT_GT(theta1[2], model.joints[0].ready * 180 / 3.141592653589793 + 0.5) << run.out;
@@ -336,4 +341,16 @@ TEST(CliRtc, JointtestSetsAndExaminesMicroboMotorParameters) {
   for (int& b : p) after >> b;
   EXPECT_EQ(p[5], 40) << run.out;
   EXPECT_NE(run.out.find("k: the value must be 0 to 255"), std::string::npos) << run.out;
+}
+
+TEST(CliRtc, MarshOnTheMicroboLetsAPushedJointStayWhereItIsLeft) {
+  // Joint 3 (d3) pushed with 60 N for the first second: it moves out, then stays, because zero
+  // gravity turns the joint law's integration off (thesis 4.5.4.4) and the target follows it.
+  const CliRun run = rccx_cli("marsh --seconds 2 --every 0.5 --push 3:60");
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  const std::vector<double> d3 = values_of(run.out, "d3");
+  ASSERT_EQ(d3.size(), 4U) << run.out;
+  const double ready_mm = kin::builtin_robot("microbo").joints[2].ready * 1e3;
+  EXPECT_GT(d3[2], ready_mm + 0.2) << "d3 did not follow the push";
+  EXPECT_NEAR(d3[3], d3[2], 0.01) << "d3 did not stay where it was left";
 }

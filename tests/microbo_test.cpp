@@ -108,7 +108,8 @@ TEST(MicroboSession, WorkAreasChangeByThemselvesOverTheWholeRangeOfJoints1And3) 
       const double distance = std::abs(joint.lower + range_target - m.rcu.true_position()[j]);
       const int samples = static_cast<int>(distance / speed / 0.028) + 40;
       for (int k = 0; k < samples; ++k) {
-        ASSERT_FALSE(m.session.wait_for(28ms).ended()) << rtc::to_string(m.session.termination().code);
+        ASSERT_FALSE(m.session.wait_for(28ms).ended())
+            << rtc::to_string(m.session.termination().code);
         const rtc::How h = m.session.how();
         worst = std::max(worst, std::abs(h.joint[j].q - m.rcu.true_position()[j]) / m.count(j));
         areas.insert(m.driver.work_area(j));
@@ -132,7 +133,8 @@ TEST(MicroboSession, WorkAreasChangeByThemselvesOverTheWholeRangeOfJoints1And3) 
 TEST(MicroboSession, ASpeedThatWouldCrossATransitionZoneIsRefusedAt56ms) {
   MicroboSession m(56ms);
   const double fast = 0.180;  // m/s, above 173 mm/s
-  m.session.control([&](rtc::Control& c) { c.chg().pos(2, c.how().joint[2].range + 0.05, fast); }, {});
+  m.session.control([&](rtc::Control& c) { c.chg().pos(2, c.how().joint[2].range + 0.05, fast); },
+                    {});
   const rtc::Termination t = m.session.wait_terminated(1s);
   EXPECT_EQ(t.code, TerminateCode::target_velocity);
   EXPECT_EQ(t.joint, 3);
@@ -197,7 +199,9 @@ struct RcuFaultCase {
   hw::RcuFault fault;
   TerminateCode code;
 };
-void PrintTo(const RcuFaultCase& c, std::ostream* os) { *os << hw::to_string(c.fault); }
+void PrintTo(const RcuFaultCase& c, std::ostream* os) {
+  *os << hw::to_string(c.fault);
+}
 class MicroboFaults : public ::testing::TestWithParam<RcuFaultCase> {};
 }  // namespace
 
@@ -244,7 +248,8 @@ TEST_P(MicroboFaults, EndTheSessionWithinTwoPeriodsAndTheArmHolds) {
 
 INSTANTIATE_TEST_SUITE_P(
     All, MicroboFaults,
-    ::testing::Values(RcuFaultCase{hw::RcuFault::joint_not_answering, TerminateCode::joint_not_answering},
+    ::testing::Values(RcuFaultCase{hw::RcuFault::joint_not_answering,
+                                   TerminateCode::joint_not_answering},
                       RcuFaultCase{hw::RcuFault::encoder_error, TerminateCode::encoder_error},
                       RcuFaultCase{hw::RcuFault::phase_error, TerminateCode::phase_error},
                       RcuFaultCase{hw::RcuFault::power_loss, TerminateCode::power_failure}),

@@ -55,8 +55,8 @@ bool run_line(hw::Rcu& rcu, const std::string& line) {
     if (!v || *v < hw::kRcuBase || *v >= hw::kRcuBase + 2 * n) return std::nullopt;
     return static_cast<std::uint16_t>(*v);
   };
-  const std::string registers = fmt::format("{:04X} to {:04X} (hex)", hw::kRcuBase,
-                                            hw::kRcuBase + 2 * rcu.model().dof() - 1);
+  const std::string registers =
+      fmt::format("{:04X} to {:04X} (hex)", hw::kRcuBase, hw::kRcuBase + 2 * rcu.model().dof() - 1);
   if (verb == "out") {
     const auto addr = address(a);
     const auto value = parse_hex(b, 0xff);
@@ -89,8 +89,9 @@ bool run_line(hw::Rcu& rcu, const std::string& line) {
       return fail(fmt::format("the joint must be 1 to {}", rcu.model().dof()));
     }
     if (!kind) {
-      return fail("the fault must be joint_not_answering, encoder_error, phase_error or "
-                  "power_loss");
+      return fail(
+          "the fault must be joint_not_answering, encoder_error, phase_error or "
+          "power_loss");
     }
     rcu.inject(*kind, *joint - 1);
     return true;

@@ -48,8 +48,7 @@ bool MicroboDriver::apply(const SettingChg& setting) noexcept {
     case Setting::acceleration:
       return put_word(j, rcu::kSetAcceleration, setting.value) == BusError::ok;
     case Setting::speed_factor:
-      return put_cmd(j, rcu::kWriteSpeedFactor) == BusError::ok &&
-             put_dat(j, byte) == BusError::ok;
+      return put_cmd(j, rcu::kWriteSpeedFactor) == BusError::ok && put_dat(j, byte) == BusError::ok;
     case Setting::examine:
       examine_ = static_cast<int>(j);
       return true;
@@ -66,11 +65,16 @@ bool MicroboDriver::apply(const SettingChg& setting) noexcept {
       parameter = 4;
       break;
   }
-  auto& p = motor_parameters_[j];
-  p[static_cast<std::size_t>(parameter - 1)] = byte;
+  motor_parameters_[j][static_cast<std::size_t>(parameter - 1)] = byte;
+  return send_motor_parameters(j, joints_[j].yielding) == BusError::ok;
+}
+
+BusError MicroboDriver::send_motor_parameters(std::size_t j, bool yielding) noexcept {
+  std::array<std::uint8_t, 16> p = motor_parameters_[j];
+  if (yielding) p[hw::motor::kDynamicIntegration] = p[hw::motor::kStaticIntegration] = 0;
   BusError e = put_cmd(j, rcu::kSetMotorParameters);
   for (std::size_t i = 0; i < p.size() && e == BusError::ok; ++i) e = put_dat(j, p[i]);
-  return e == BusError::ok;
+  return e;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -141,7 +145,8 @@ BusError MicroboDriver::get_byte(std::size_t joint, std::uint8_t command,
 
 double MicroboDriver::counts_of(std::size_t joint, double q) const noexcept {
   const hw::RcuJointConfig& c = config_.joints[joint];
-  return c.initialize_counts + (q - c.calibration_position) / model_.joints[joint].resolution_per_count;
+  return c.initialize_counts +
+         (q - c.calibration_position) / model_.joints[joint].resolution_per_count;
 }
 
 double MicroboDriver::joint_value_of(std::size_t joint, double counts) const noexcept {
@@ -247,7 +252,8 @@ void MicroboDriver::read(double t_s, How& how) noexcept {
     BusError e = BusError::ok;
     for (std::size_t i = 0; i < 16 && e == BusError::ok; i += 2) {
       std::uint16_t word = 0;
-      e = put_word(j, rcu::kSetRamPointer, static_cast<std::uint16_t>(hw::kRcuMotorParameterRam + i));
+      e = put_word(j, rcu::kSetRamPointer,
+                   static_cast<std::uint16_t>(hw::kRcuMotorParameterRam + i));
       if (e == BusError::ok) e = get_word(j, rcu::kReadRamWord, word);
       examined_parameters_[i] = static_cast<std::uint8_t>(word & 0xff);
       examined_parameters_[i + 1] = static_cast<std::uint8_t>(word >> 8);
@@ -289,6 +295,11 @@ void MicroboDriver::follow(std::size_t j, JointState& s) noexcept {
     const std::uint16_t a = config_.joints[j].follow_acceleration;
     s.set_up = a == 0 || put_word(j, rcu::kSetAcceleration, a) == BusError::ok;
   }
+  if (zero_gravity_ != s.yielding) {
+    // Zero gravity as the thesis did it (4.5.4.4): integration off at the joint level, so
+    // that a push is not fought back once it ends; on leaving, the parameters as they were.
+    if (send_motor_parameters(j, zero_gravity_) == BusError::ok) s.yielding = zero_gravity_;
+  }
   if (zero_gravity_) {
     s.following = false;
     s.desired = s.measured;  // servo to where the joint is: it yields to a push
@@ -307,7 +318,8 @@ void MicroboDriver::follow(std::size_t j, JointState& s) noexcept {
       const double wanted = std::copysign(std::min(s.rate, braking), left);
       s.pace += std::clamp(wanted - s.pace, -accel * period, accel * period);
       const double step = s.pace * period;
-      s.desired = std::abs(step) >= std::abs(left) || step * left <= 0.0 ? s.goal : s.desired + step;
+      s.desired =
+          std::abs(step) >= std::abs(left) || step * left <= 0.0 ? s.goal : s.desired + step;
     }
     if (s.desired == s.goal) {  // then held there
       s.following = false;
@@ -325,7 +337,8 @@ void MicroboDriver::follow(std::size_t j, JointState& s) noexcept {
   }
   // The vendor law never moves faster than its speed setting: catching up on a lag, the joint
   // must still not outrun what a sample may carry it (the work areas) or its top speed.
-  speed = std::min(std::abs(speed), velocity_limit(j, period) / model_.joints[j].resolution_per_count);
+  speed =
+      std::min(std::abs(speed), velocity_limit(j, period) / model_.joints[j].resolution_per_count);
   // X runs ahead of Xd by the lag: never past the joint's limits (while calibration brings a
   // joint in from its stop, its target is inside already).
   const kin::Joint& m = model_.joints[j];

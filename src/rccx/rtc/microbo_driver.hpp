@@ -91,14 +91,15 @@ class MicroboDriver final : public Driver {
     bool initialized = false;
     bool calibrating = false;
     BusError error = BusError::ok;
-    double measured = 0.0;  ///< absolute counts at the last read
-    double desired = 0.0;   ///< Xd: where the joint is to be at the end of this period, counts
-    double goal = 0.0;      ///< where a POS / POSVEL command goes, counts
-    double rate = 0.0;      ///< counts/s toward goal; 0 = at once
-    double pace = 0.0;      ///< counts/s the desired point moves at now (signed)
-    bool following = false; ///< a goal is being followed (else: holding `desired`)
-    bool set_up = false;    ///< the follow acceleration was sent since the last INITIALIZE
-    bool returning = false; ///< calibrated at the stop, on the way back inside the range
+    double measured = 0.0;   ///< absolute counts at the last read
+    double desired = 0.0;    ///< Xd: where the joint is to be at the end of this period, counts
+    double goal = 0.0;       ///< where a POS / POSVEL command goes, counts
+    double rate = 0.0;       ///< counts/s toward goal; 0 = at once
+    double pace = 0.0;       ///< counts/s the desired point moves at now (signed)
+    bool following = false;  ///< a goal is being followed (else: holding `desired`)
+    bool set_up = false;     ///< the follow acceleration was sent since the last INITIALIZE
+    bool returning = false;  ///< calibrated at the stop, on the way back inside the range
+    bool yielding = false;   ///< the joint's integration is off for zero gravity
   };
 
   /// The desired point of a POS motion accelerates at this fraction of what the joint's
@@ -108,6 +109,9 @@ class MicroboDriver final : public Driver {
   static constexpr double kSettledCounts = 20.0;
 
   void follow(std::size_t j, JointState& s) noexcept;
+  /// Sends joint j's 16 motor parameters (0EH): as last set, with the integration constants
+  /// zeroed while `yielding`.
+  BusError send_motor_parameters(std::size_t j, bool yielding) noexcept;
   std::uint16_t speed_setting(std::size_t j, double counts_per_s) const noexcept;
 
   kin::RobotModel model_;

@@ -1,8 +1,8 @@
 #include "rccx/rtc/microbo_trial.hpp"
 
+#include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
-#include <Eigen/Dense>
 #include <numbers>
 #include <numeric>
 
