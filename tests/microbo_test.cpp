@@ -86,6 +86,20 @@ TEST(MicroboDriver, FollowSchemeTracksARampWhereRawTargetsOscillate) {
   EXPECT_LT(follow.speed_ripple(), raw.speed_ripple());
 }
 
+TEST(MicroboSession, RefusesAPeriodShorterThanItsBusNeeds) {
+  Microbo m;
+  // 6 x 22 exchanges plus two work-area changes, x 75 us, with a tenth to spare: 11.2 ms.
+  EXPECT_NEAR(m.driver.minimum_period_s(), 1.1 * (6 * 22 + 2 * 2) * 75e-6, 1e-12);
+  try {
+    rtc::Session s(m.driver, {.period = 10ms, .clock = rtc::ClockKind::simulated});
+    ADD_FAILURE() << "a 10 ms period was accepted";
+  } catch (const rtc::SessionError& e) {
+    EXPECT_NE(std::string(e.what()).find("too short for robot microbo"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_NO_THROW(rtc::Session(m.driver, {.period = 12ms, .clock = rtc::ClockKind::simulated}));
+}
+
 TEST(MicroboDriver, WorkAreaSpeedLimitIsTheThesisFigure) {
   Microbo m;
   // Joint 3: 7450 counts x 0.0013 mm in 56 ms = 173 mm/s; at 28 ms the 200 mm/s top speed rules.
@@ -186,7 +200,13 @@ TEST(MicroboSession, StopcalInitializesEveryJoint) {
       << rtc::to_string(m.session.termination().code);
   const rtc::How h = m.session.how();
   const rtc::JointVector truth = m.rcu.true_position();
+  const rtc::JointVector speed = m.rcu.true_velocity();
   for (std::size_t i = 0; i < h.dof; ++i) {
+    // Calibrated means back inside the range and come to rest: slower than 1 % of top speed
+    // (the vendor law's static zone still creeps, at a fraction of a degree a second).
+    EXPECT_GE(h.joint[i].q, m.model.joints[i].lower) << "joint " << i + 1;
+    EXPECT_LT(std::abs(speed[i]), 0.01 * m.model.joints[i].max_velocity)
+        << "joint " << i + 1 << " still moving";
     // INITIALIZE assigns its value while the joint presses on its stop: a few counts of give.
     EXPECT_NEAR(h.joint[i].q, truth[i], 10 * m.count(i)) << "joint " << i + 1;
     EXPECT_EQ(m.driver.work_area(i), m.rcu.work_area(i));

@@ -519,13 +519,13 @@ TEST(RtcWatchdog, AMissedKickInRealTimeEndsTheSessionWithOverrun) {
   rtc::SessionOptions o;
   o.clock = rtc::ClockKind::real_time;
   o.real_time_scheduling = false;  // a test must not take a core from the others
-  o.period = 5ms;
+  o.period = 20ms;  // long enough that a loaded test machine does not overrun by itself
   Rig r("stanford", o);
   std::atomic<bool> stall{false};
   r.session.control({}, [&](rtc::Control&) {
-    if (stall.exchange(false)) std::this_thread::sleep_for(40ms);  // never kicks in time
+    if (stall.exchange(false)) std::this_thread::sleep_for(100ms);  // never kicks in time
   });
-  std::this_thread::sleep_for(50ms);
+  std::this_thread::sleep_for(60ms);
   ASSERT_FALSE(r.session.termination().ended()) << "ended before the stall";
   stall = true;
   const rtc::Termination t = r.session.wait_terminated(2s);

@@ -112,7 +112,11 @@ struct SimulatedRobot {
     rtc::SessionOptions options;
     options.period = parse_period(a.period.empty() ? (rcu ? "28ms" : "10ms") : a.period);
     options.clock = a.realtime ? rtc::ClockKind::real_time : rtc::ClockKind::simulated;
-    session = std::make_unique<rtc::Session>(*driver, options);
+    try {
+      session = std::make_unique<rtc::Session>(*driver, options);
+    } catch (const rtc::SessionError& e) {
+      throw BadArgument{fmt::format("--period: {}", e.what())};
+    }
   }
   [[nodiscard]] bool simulated() const { return session->clock() == rtc::ClockKind::simulated; }
   [[nodiscard]] double period_s() const { return Seconds(session->period()).count(); }
@@ -602,6 +606,9 @@ int run_jointtest(const RtcArgs& a) {
             fmt::print("sample period {:.3f} ms\n", r.period_s() * 1e3);
           } catch (const BadArgument& e) {
             fmt::print(stderr, "r: {}\n", e.message);
+          } catch (const rtc::SessionError& e) {
+            fmt::print(stderr, "r: {}\n", e.what());
+            start();  // control again at the period it had
           }
         }
         break;

@@ -47,6 +47,8 @@ class Driver {
     (void)period_s;
     return model().joints[joint].max_velocity;
   }
+  /// The shortest sample period this robot's link can serve (its bus traffic per sample), s.
+  [[nodiscard]] virtual double minimum_period_s() const noexcept { return 0.0; }
   /// What went wrong with a joint the last read flagged (e.g. "TIMEOUT_GET"); may be empty.
   [[nodiscard]] virtual std::string_view fault_detail(std::size_t joint) const noexcept {
     (void)joint;

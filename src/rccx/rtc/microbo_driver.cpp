@@ -164,6 +164,12 @@ double MicroboDriver::velocity_limit(std::size_t joint, double period_s) const n
   return std::min(top, zone * model_.joints[joint].resolution_per_count / period_s);
 }
 
+double MicroboDriver::minimum_period_s() const noexcept {
+  double exchanges = 0;
+  for (const hw::RcuJointConfig& c : config_.joints) exchanges += c.work_areas ? 24 : 22;
+  return 1.1 * exchanges * config_.exchange_us * 1e-6;
+}
+
 std::string_view MicroboDriver::fault_detail(std::size_t joint) const noexcept {
   return joint < model_.dof() && joints_[joint].error != BusError::ok
              ? to_string(joints_[joint].error)
@@ -211,6 +217,7 @@ void MicroboDriver::read(double t_s, How& how) noexcept {
     if ((status & hw::kStatusEncoderError) != 0) flags |= kEncoderError;
     if ((status & hw::kStatusPhaseError) != 0) flags |= kPhaseError;
     if ((status & hw::kStatusFault) != 0) flags |= kJointFault;
+    const double before = s.measured;
     s.measured = e + static_cast<double>(hw::kWorkAreaShift) * s.area;
     // Work areas (figure 4.4): past a threshold the joint changes area, which it accepts there;
     // the absolute count stays, the register moves by 50000.
@@ -231,7 +238,8 @@ void MicroboDriver::read(double t_s, How& how) noexcept {
       s.rate = 0.1 * m.max_velocity / m.resolution_per_count;
       s.following = true;
     }
-    if (s.returning && !s.following && std::abs(s.measured - s.goal) <= kSettledCounts) {
+    if (s.returning && !s.following && std::abs(s.measured - s.goal) <= kSettledCounts &&
+        std::abs(s.measured - before) <= kStillCounts) {
       s.returning = false;
       s.calibrating = false;
     }

@@ -66,6 +66,9 @@ class MicroboDriver final : public Driver {
   /// transition zone in one period (thesis 4.4.3: joint 3, 173 mm/s at 56 ms).
   [[nodiscard]] double velocity_limit(std::size_t joint, double period_s) const noexcept override;
   [[nodiscard]] std::string_view fault_detail(std::size_t joint) const noexcept override;
+  /// A sample's bus traffic: 22 exchanges a joint (status, position, target, speed) and a
+  /// work-area change for each joint that has them, with a tenth to spare.
+  [[nodiscard]] double minimum_period_s() const noexcept override;
   /// Acceleration (10H), speed factor (2CH), the motor parameters k, K, V, z (0EH with the
   /// other 15 as last sent) and examine (RAM reads 22H / 2EH, in the next read).
   bool apply(const SettingChg& setting) noexcept override;
@@ -107,6 +110,8 @@ class MicroboDriver final : public Driver {
   static constexpr double kPaceAccelerationFraction = 0.5;
   /// A joint within this many counts of where calibration returns it has arrived.
   static constexpr double kSettledCounts = 20.0;
+  /// ... and at rest when it moved no more than this between two reads.
+  static constexpr double kStillCounts = 2.0;
 
   void follow(std::size_t j, JointState& s) noexcept;
   /// Sends joint j's 16 motor parameters (0EH): as last set, with the integration constants

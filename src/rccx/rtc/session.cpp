@@ -200,6 +200,14 @@ Session::~Session() {
 }
 
 void Session::check_period(std::chrono::nanoseconds p) const {
+  const double needed_s = driver_.minimum_period_s();
+  if (std::chrono::duration<double>(p).count() < needed_s) {
+    throw SessionError(fmt::format(
+        "sample period {} ms is too short for robot {}: its link needs {:.1f} ms a sample; "
+        "choose at least that",
+        std::chrono::duration<double, std::milli>(p).count(), driver_.model().name,
+        needed_s * 1e3));
+  }
   if (p < kMinPeriod || p > kMaxPeriod) {
     using ms = std::chrono::duration<double, std::milli>;
     throw SessionError(fmt::format("sample period {} ms is outside {} .. {} ms", ms(p).count(),
