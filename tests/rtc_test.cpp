@@ -5,14 +5,19 @@
 #include <atomic>
 #include <chrono>
 #include <csignal>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
 #include <map>
 #include <optional>
 #include <set>
+#include <sstream>
 #include <thread>
 #include <vector>
 
 #include "rccx/hw/ideal_arm.hpp"
 #include "rccx/hw/simulated_arm.hpp"
+#include "rccx/kinematics/kinematics.hpp"
 #include "rccx/rtc/servo_driver.hpp"
 #include "rccx/rtc/session.hpp"
 
@@ -661,4 +666,95 @@ TEST(RtcCodes, EveryCodeHasANameAndAMeaning) {
   }
   EXPECT_EQ(names.size(), rtc::all_terminate_codes().size());
   EXPECT_EQ(rtc::to_string(static_cast<TerminateCode>(999)), "unknown");
+}
+
+// ---------------------------------------------------------------------------------------------
+// The sample log
+
+namespace {
+
+std::vector<std::vector<double>> read_csv(const std::string& path, std::string& header) {
+  std::ifstream in(path);
+  std::getline(in, header);
+  std::vector<std::vector<double>> rows;
+  std::string line;
+  while (std::getline(in, line)) {
+    std::vector<double> row;
+    std::istringstream cells(line);
+    std::string cell;
+    while (std::getline(cells, cell, ',')) row.push_back(std::stod(cell));
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+}  // namespace
+
+TEST(RtcLog, EveryControlledSampleIsARowWithTheCommandedToolPose) {
+  const std::string path = ::testing::TempDir() + "rtc_log_test.csv";
+  Rig r("puma560");
+  std::uint64_t samples = 0;
+  double setpoint = 0;  // range value of joint 2
+  {
+    rtc::SampleLog log(path, r.model);
+    r.session.set_log(&log);
+    r.session.control(
+        [&](rtc::Control& c) {
+          ++samples;
+          c.chg().segment = static_cast<std::int32_t>(samples / 10);
+          if (samples == 1) setpoint = c.how().joint[1].range;
+          setpoint += 0.001;  // joint 2 creeps up 1 mrad a sample
+          c.chg().posvel(1, setpoint);
+        },
+        {});
+    r.session.wait_for(300ms);
+    r.session.release();
+    r.session.set_log(nullptr);
+    EXPECT_EQ(log.rows_dropped(), 0U);
+  }  // the log is written out and closed here
+  std::string header;
+  const auto rows = read_csv(path, header);
+  EXPECT_EQ(header, "t,seg,q1,q2,q3,q4,q5,q6,qm1,qm2,qm3,qm4,qm5,qm6,x,y,z,ax,ay,az");
+  ASSERT_EQ(rows.size(), samples);
+  const auto kinematics = kin::make_kinematics(r.model);
+  for (std::size_t k = 0; k < rows.size(); ++k) {
+    const auto& row = rows[k];
+    ASSERT_EQ(row.size(), 20U);
+    if (k > 0) {
+      EXPECT_NEAR(row[0] - rows[k - 1][0], 0.010, 1e-9) << "one row a 10 ms sample";
+    }
+    EXPECT_EQ(row[1], static_cast<double>((k + 1) / 10)) << "the segment f1 set";
+    const kin::JointVector q{row[2], row[3], row[4], row[5], row[6], row[7]};
+    const math::Transform T = kinematics->forward(q);
+    EXPECT_NEAR(row[14], T.p.x, 1e-8);
+    EXPECT_NEAR(row[15], T.p.y, 1e-8);
+    EXPECT_NEAR(row[16], T.p.z, 1e-8);
+    EXPECT_NEAR(row[19], T.R.a.z, 1e-8);
+    // Measured joint 2 follows the commanded one (the PID servo lags by well under 1 deg).
+    EXPECT_NEAR(row[9], row[3], 0.02);
+  }
+  // 1 mrad a sample for 30 samples.
+  EXPECT_NEAR(rows.back()[3] - rows.front()[3], 0.001 * static_cast<double>(rows.size() - 1), 1e-9)
+      << "joint 2 was commanded upward";
+  if (!HasFailure()) std::remove(path.c_str());
+}
+
+TEST(RtcLog, TheEnvironmentNamesALogForAnySession) {
+  const std::string path = ::testing::TempDir() + "rtc_env_log_test.csv";
+  ::setenv("RCCX_LOG", path.c_str(), 1);
+  {
+    Rig r("stanford");
+    ::unsetenv("RCCX_LOG");
+    r.session.control({}, {});
+    r.session.wait_for(100ms);
+    r.session.release();
+  }
+  std::string header;
+  const auto rows = read_csv(path, header);
+  EXPECT_EQ(header.substr(0, 8), "t,seg,q1");
+  EXPECT_EQ(rows.size(), 10U);
+  std::remove(path.c_str());
+  ::setenv("RCCX_LOG", "/nonexistent/dir/log.csv", 1);
+  EXPECT_THROW(Rig("stanford"), rtc::SessionError);
+  ::unsetenv("RCCX_LOG");
 }

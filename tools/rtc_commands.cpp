@@ -67,6 +67,7 @@ struct RtcArgs {
   std::string period;  ///< empty: the robot's usual period
   bool realtime = false;
   bool uncalibrated = false;
+  std::string log;  ///< CSV of every controlled sample
 };
 
 void add_rtc_options(CLI::App& cmd, RtcArgs& a) {
@@ -79,6 +80,9 @@ void add_rtc_options(CLI::App& cmd, RtcArgs& a) {
                "deterministic and runs as fast as the machine allows");
   cmd.add_flag("--uncalibrated", a.uncalibrated,
                "Start the simulated robot uncalibrated (encoders relative to power-up)");
+  cmd.add_option("--log", a.log,
+                 "Write every controlled sample to this CSV file: t,seg,q1..,qm1..,x,y,z,ax,ay,az "
+                 "(s, rad or m; the environment's RCCX_LOG does the same for any program)");
 }
 
 /// A simulated robot below the wire and an RTC session on it: the Microbo's emulated RCU
@@ -90,6 +94,7 @@ struct SimulatedRobot {
   std::unique_ptr<hw::Rcu> rcu;
   std::unique_ptr<hw::RcuBus> bus;
   std::unique_ptr<rtc::Driver> driver;
+  std::unique_ptr<rtc::SampleLog> log;
   std::unique_ptr<rtc::Session> session;
 
   explicit SimulatedRobot(const RtcArgs& a) : model(a.robot.model()) {
@@ -116,6 +121,14 @@ struct SimulatedRobot {
       session = std::make_unique<rtc::Session>(*driver, options);
     } catch (const rtc::SessionError& e) {
       throw BadArgument{fmt::format("--period: {}", e.what())};
+    }
+    if (!a.log.empty()) {
+      try {
+        log = std::make_unique<rtc::SampleLog>(a.log, model);
+      } catch (const rtc::LogError& e) {
+        throw BadArgument{fmt::format("--log: {}", e.what())};
+      }
+      session->set_log(log.get());
     }
   }
   [[nodiscard]] bool simulated() const { return session->clock() == rtc::ClockKind::simulated; }

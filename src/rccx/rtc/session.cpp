@@ -116,6 +116,7 @@ struct Session::Shared {
   std::atomic<std::int64_t> simulated_now_ns{0};
   std::atomic<std::int64_t> period_ns{0};
   std::int64_t t0_ns = 0;  ///< real time: the monotonic time the session opened
+  std::atomic<SampleLog*> log{nullptr};
 
   How how;                  ///< guarded by how_ready / the next tick
   Chg chg;                  ///< guarded by chg_ready / chg_taken
@@ -173,14 +174,20 @@ Session::Session(Driver& driver, SessionOptions options)
       options_(options),
       period_(options.period),
       shared_(std::make_unique<Shared>()) {
-  check_period(period_);
   if (driver_.model().dof() == 0 || driver_.model().dof() > kMaxJoints) {
     throw SessionError(fmt::format("robot {} has {} joints; RTC serves 1 to {}",
                                    driver_.model().name, driver_.model().dof(), kMaxJoints));
   }
+  check_period(period_);
   Shared& s = *shared_;
   s.period_ns = period_.count();
   s.t0_ns = monotonic_ns();
+  try {
+    environment_log_ = SampleLog::from_environment(driver_.model());
+  } catch (const LogError& e) {
+    throw SessionError(fmt::format("RCCX_LOG: {}", e.what()));
+  }
+  s.log = environment_log_.get();
   s.control.session_ = this;
   communication_thread_ = std::thread([this] { communication_task(); });
   control_thread_ = std::thread([this] { control_task(); });
@@ -348,6 +355,11 @@ How Session::how() const {
 
 LatencyStats Session::latency() const {
   return shared_->latency.stats();
+}
+
+void Session::set_log(SampleLog* log) {
+  if (controlling()) throw SessionError("set the log before control()");
+  shared_->log.store(log, std::memory_order_release);
 }
 
 void Session::set_hangup_handler(std::function<void(Session&)> handler) {
@@ -619,6 +631,17 @@ void Session::controlled_cycle(CommState& c) noexcept {
   s.chg_taken.store(c.k, std::memory_order_release);
   ring(s.control_bell);
   apply(c, c.chg);
+  if (SampleLog* log = s.log.load(std::memory_order_acquire)) {
+    LogRow row;
+    row.t_s = h.time_s;
+    row.segment = c.chg.segment;
+    row.measured = h.q();
+    row.commanded = row.measured;
+    for (std::size_t i = 0; i < h.dof; ++i) {
+      if (c.has_target[i]) row.commanded[i] = c.last_target[i];
+    }
+    log->push(row);
+  }
 }
 
 void Session::apply(CommState& c, const Chg& chg) noexcept {

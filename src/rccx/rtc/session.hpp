@@ -29,6 +29,7 @@
 
 #include "rccx/rtc/driver.hpp"
 #include "rccx/rtc/latency.hpp"
+#include "rccx/rtc/sample_log.hpp"
 #include "rccx/rtc/types.hpp"
 
 namespace rccx::rtc {
@@ -136,6 +137,10 @@ class Session {
   void set_period(std::chrono::nanoseconds period);
   [[nodiscard]] ClockKind clock() const noexcept { return options_.clock; }
   [[nodiscard]] Driver& driver() noexcept { return driver_; }
+  /// Records every controlled sample to `log` (commanded and measured joints, the commanded
+  /// tool pose); nullptr stops. Only while not in control. Without a call, a session logs to
+  /// the file named by the environment variable RCCX_LOG, if any.
+  void set_log(SampleLog* log);
   /// Wake-up latency of the communication task (real time only).
   [[nodiscard]] LatencyStats latency() const;
 
@@ -169,6 +174,7 @@ class Session {
   std::chrono::nanoseconds period_;
   std::unique_ptr<Shared> shared_;
   std::function<void(Session&)> hangup_handler_;
+  std::unique_ptr<SampleLog> environment_log_;  ///< RCCX_LOG's, when set
   ControlFunction f1_, f2_;
   std::uint32_t simulated_ticks_ = 0;  ///< planning side: ticks granted in simulated time
   std::thread communication_thread_;

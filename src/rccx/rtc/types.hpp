@@ -76,6 +76,7 @@ struct Chg {
   std::uint16_t outputs_set = 0;         ///< output bits to set this sample
   std::uint16_t outputs_clear = 0;       ///< output bits to clear this sample
   SettingChg setting;                    ///< one controller setting per sample
+  std::int32_t segment = 0;  ///< the motion segment this sample belongs to (for the log; kept)
 
   /// Conveniences; `joint` is 0-based.
   void pos(std::size_t joint, double range_target, double velocity = 0.0) noexcept {
@@ -85,11 +86,13 @@ struct Chg {
     motion[joint] = {SetMode::posvel, range_target, 0.0};
   }
   void stopcal(std::size_t joint) noexcept { motion[joint] = {SetMode::stopcal, 0.0, 0.0}; }
-  /// Clears the one-shot commands, keeps the checking mode.
+  /// Clears the one-shot commands, keeps the checking mode and the segment.
   void clear_commands() noexcept {
     const std::uint8_t keep = checking;
+    const std::int32_t seg = segment;
     *this = Chg{};
     checking = keep;
+    segment = seg;
   }
 };
 
