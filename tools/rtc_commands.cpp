@@ -23,6 +23,7 @@
 #include "rccx/rtc/microbo_driver.hpp"
 #include "rccx/rtc/servo_driver.hpp"
 #include "rccx/rtc/session.hpp"
+#include "rccx/rtc/simulated_robot.hpp"
 
 namespace rccx::tools {
 
@@ -85,60 +86,27 @@ void add_rtc_options(CLI::App& cmd, RtcArgs& a) {
                  "(s, rad or m; the environment's RCCX_LOG does the same for any program)");
 }
 
-/// A simulated robot below the wire and an RTC session on it: the Microbo's emulated RCU
-/// behind its bus and register-level driver when the robot file describes an RCU, else a
-/// servo arm (the PUMA's PID servos, or the ideal servo).
-struct SimulatedRobot {
-  kin::RobotModel model;
-  std::unique_ptr<hw::SimulatedArm> arm;
-  std::unique_ptr<hw::Rcu> rcu;
-  std::unique_ptr<hw::RcuBus> bus;
-  std::unique_ptr<rtc::Driver> driver;
-  std::unique_ptr<rtc::SampleLog> log;
-  std::unique_ptr<rtc::Session> session;
+/// The simulated robot the options ask for, its errors turned into bad arguments.
+struct SimulatedRobot : rtc::SimulatedRobot {
+  explicit SimulatedRobot(const RtcArgs& a) : rtc::SimulatedRobot(make(a)) {}
 
-  explicit SimulatedRobot(const RtcArgs& a) : model(a.robot.model()) {
-    hw::SimulatedArmOptions arm_options;
-    arm_options.calibrated = !a.uncalibrated;
+ private:
+  static rtc::SimulatedRobot make(const RtcArgs& a) {
+    kin::RobotModel model = a.robot.model();
+    rtc::SimulatedRobotOptions o;
+    o.calibrated = !a.uncalibrated;
+    o.clock = a.realtime ? rtc::ClockKind::real_time : rtc::ClockKind::simulated;
+    if (!a.period.empty()) o.period = parse_period(a.period);
+    o.log = a.log;
+    const std::string name = model.name;
     try {
-      if (!model.hardware_json.empty()) {
-        rcu = std::make_unique<hw::Rcu>(model, arm_options);
-        bus = std::make_unique<hw::RcuBus>(*rcu);
-        rtc::MicroboDriverOptions o;
-        for (std::size_t j = 0; j < model.dof(); ++j) o.work_areas[j] = rcu->work_area(j);
-        driver = std::make_unique<rtc::MicroboDriver>(model, *bus, *rcu, o);
-      } else {
-        arm = hw::make_simulated_arm(model, arm_options);
-        driver = std::make_unique<rtc::ServoDriver>(*arm);
-      }
-    } catch (const std::invalid_argument& e) {
-      throw BadArgument{fmt::format("robot {} cannot be simulated: {}", model.name, e.what())};
-    }
-    rtc::SessionOptions options;
-    options.period = parse_period(a.period.empty() ? (rcu ? "28ms" : "10ms") : a.period);
-    options.clock = a.realtime ? rtc::ClockKind::real_time : rtc::ClockKind::simulated;
-    try {
-      session = std::make_unique<rtc::Session>(*driver, options);
+      return rtc::SimulatedRobot(std::move(model), o);
     } catch (const rtc::SessionError& e) {
       throw BadArgument{fmt::format("--period: {}", e.what())};
-    }
-    if (!a.log.empty()) {
-      try {
-        log = std::make_unique<rtc::SampleLog>(a.log, model);
-      } catch (const rtc::LogError& e) {
-        throw BadArgument{fmt::format("--log: {}", e.what())};
-      }
-      session->set_log(log.get());
-    }
-  }
-  [[nodiscard]] bool simulated() const { return session->clock() == rtc::ClockKind::simulated; }
-  [[nodiscard]] double period_s() const { return Seconds(session->period()).count(); }
-  /// A simulated hand pushes a joint (N m or N); only between samples of simulated time.
-  void push(std::size_t joint, double effort) {
-    if (rcu) {
-      rcu->set_external_effort(joint, effort);
-    } else {
-      arm->set_external_effort(joint, effort);
+    } catch (const rtc::LogError& e) {
+      throw BadArgument{fmt::format("--log: {}", e.what())};
+    } catch (const std::invalid_argument& e) {
+      throw BadArgument{fmt::format("robot {} cannot be simulated: {}", name, e.what())};
     }
   }
 };

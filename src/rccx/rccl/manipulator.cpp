@@ -1,0 +1,240 @@
+#include "rccx/rccl/manipulator.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace rccx::rccl {
+
+std::string_view to_string(WaitResult r) noexcept {
+  switch (r) {
+    case WaitResult::reached: return "reached";
+    case WaitResult::failed: return "failed";
+    case WaitResult::timeout: return "timeout";
+    case WaitResult::session_ended: return "session ended";
+  }
+  return "?";
+}
+
+namespace {
+
+GeneratorOptions generator_options(rtc::Session& session) {
+  GeneratorOptions o;
+  o.period_s = std::chrono::duration<double>(session.period()).count();
+  const kin::RobotModel& m = session.driver().model();
+  o.max_velocity = kin::JointVector(m.dof());
+  for (std::size_t j = 0; j < m.dof(); ++j) {
+    o.max_velocity[j] = session.driver().velocity_limit(j, o.period_s);  // work areas, ...
+  }
+  return o;
+}
+
+}  // namespace
+
+Manipulator::Manipulator(rtc::Session& session)
+    : session_(session),
+      kinematics_(kin::make_kinematics(session.driver().model())),
+      generator_(std::make_unique<TrajectoryGenerator>(*kinematics_, generator_options(session))),
+      lower_(kinematics_->model().lower()),
+      park_(Position::joints("park", kinematics_->model().ready())) {}
+
+Manipulator::~Manipulator() {
+  if (started_) {
+    try {
+      stop_control();
+    } catch (...) {  // nothing sensible to do in a destructor
+    }
+  }
+}
+
+void Manipulator::start() {
+  first_sample_ = true;
+  session_.control({}, [this](rtc::Control& c) {
+    const rtc::How& h = c.how();
+    const kin::JointVector measured = h.q();
+    // The setpoint written now goes out with the next sample and is reached one period later.
+    const double t_set = h.time_s + 2.0 * c.period_s();
+    if (first_sample_) {
+      generator_->reset(measured, t_set);
+      first_sample_ = false;
+    }
+    const SampleContext ctx{t_set, h.sample, &h};
+    kin::JointVector q;
+    const std::uint64_t id = generator_->step(ctx, &measured, q);
+    for (std::size_t j = 0; j < q.size(); ++j) c.chg().posvel(j, q[j] - lower_[j]);
+    c.chg().segment = static_cast<std::int32_t>(id);
+  });
+  started_ = true;
+}
+
+rtc::Termination Manipulator::stop_control() {
+  started_ = false;
+  return session_.release();
+}
+
+void Manipulator::set_velocity(double translation_m_per_s, double rotation_rad_per_s) {
+  if (!(translation_m_per_s > 0.0) || !(rotation_rad_per_s > 0.0) ||
+      !std::isfinite(translation_m_per_s) || !std::isfinite(rotation_rad_per_s)) {
+    throw MotionError(fmt::format("velocities must be finite and > 0 (got {} m/s, {} rad/s)",
+                                  translation_m_per_s, rotation_rad_per_s));
+  }
+  settings_.translation_m_per_s = translation_m_per_s;
+  settings_.rotation_rad_per_s = rotation_rad_per_s;
+}
+
+void Manipulator::set_segment_time(double seconds) {
+  if (!(seconds >= 0.0) || !std::isfinite(seconds)) {
+    throw MotionError(fmt::format("segment time must be >= 0 s (0: from the speeds), got {}",
+                                  seconds));
+  }
+  settings_.segment_time_s = seconds;
+}
+
+void Manipulator::set_transition_time(double seconds) {
+  if (!(seconds > 0.0) || !std::isfinite(seconds)) {
+    throw MotionError(fmt::format("transition time must be > 0 s, got {}", seconds));
+  }
+  settings_.transition_time_s = seconds;
+}
+
+void Manipulator::set_configuration(std::string_view name) {
+  if (name.empty()) {
+    settings_.configuration = -1;
+    return;
+  }
+  const auto c = kinematics_->find_configuration(name);
+  if (!c) {
+    std::string known;
+    for (std::string_view n : kinematics_->configuration_names()) {
+      known += known.empty() ? "" : ", ";
+      known += n;
+    }
+    throw MotionError(fmt::format("robot {} has no configuration '{}' (it has: {})",
+                                  kinematics_->model().name, name,
+                                  known.empty() ? "none" : known));
+  }
+  settings_.configuration = c->index;
+}
+
+void Manipulator::check_reachable(const Position& p) const {
+  if (p.in_joints()) {
+    const kin::JointVector& q = p.joint_values();
+    if (q.size() != kinematics_->dof()) {
+      throw MotionError(fmt::format("position {} has {} joint values; robot {} has {} joints",
+                                    p.name(), q.size(), kinematics_->model().name,
+                                    kinematics_->dof()));
+    }
+    const int out = kinematics_->model().first_joint_outside_limits(q, kin::kLimitTolerance);
+    if (out >= 0) {
+      const kin::Joint& j = kinematics_->model().joints[static_cast<std::size_t>(out)];
+      throw MotionError(fmt::format("position {}: joint {} ({}) = {:.6g} is outside its limits "
+                                    "[{:.6g}, {:.6g}]",
+                                    p.name(), out + 1, j.name, q[static_cast<std::size_t>(out)],
+                                    j.lower, j.upper));
+    }
+    return;
+  }
+  if (p.moves()) return;  // checked by the generator, every sample
+  kin::IkOptions o;
+  if (settings_.configuration >= 0) {
+    o.configuration = kin::Configuration{static_cast<std::uint8_t>(settings_.configuration)};
+  }
+  const kin::IkResult r = kinematics_->inverse(p.t6_now(), o);
+  if (!r) {
+    throw MotionError(fmt::format("position {} cannot be reached{}: {}", p.name(),
+                                  o.configuration ? " in the configuration asked for" : "",
+                                  kin::describe(r.status)));
+  }
+}
+
+Motion Manipulator::submit(MotionRequest r, const PositionPtr& keep) {
+  if (!started_) throw MotionError("call start() (rccl_control) before queuing motions");
+  r.id = next_id_;
+  r.settings = settings_;
+  if (keep && std::find(keep_.begin(), keep_.end(), keep) == keep_.end()) keep_.push_back(keep);
+  if (keep) keep->pending_ends.fetch_add(1, std::memory_order_acq_rel);
+  if (!generator_->submit(r)) {
+    if (keep) keep->pending_ends.fetch_sub(1, std::memory_order_acq_rel);
+    throw MotionError(fmt::format("the motion queue is full ({} requests); waitfor some to end",
+                                  TrajectoryGenerator::kQueueCapacity));
+  }
+  ++next_id_;
+  return {r.id};
+}
+
+Motion Manipulator::move(const PositionPtr& position) {
+  if (!position) throw MotionError("move(): the position is null");
+  check_reachable(*position);
+  MotionRequest r;
+  r.kind = RequestKind::move;
+  r.position = position.get();
+  return submit(r, position);
+}
+
+Motion Manipulator::dwell(double seconds) {
+  if (!(seconds >= 0.0) || !std::isfinite(seconds)) {
+    throw MotionError(fmt::format("dwell time must be >= 0 s, got {}", seconds));
+  }
+  MotionRequest r;
+  r.kind = RequestKind::dwell;
+  r.dwell_s = seconds;
+  return submit(r, nullptr);
+}
+
+void Manipulator::halt() {
+  generator_->request_halt();
+}
+
+bool Manipulator::happened(const Event& e) const noexcept {
+  switch (e.kind) {
+    case Event::Kind::motion_start: return generator_->started_upto() >= e.id;
+    case Event::Kind::motion_end: return generator_->ended_upto() >= e.id;
+    case Event::Kind::position_end:
+      return e.position->pending_ends.load(std::memory_order_acquire) <= 0;
+    case Event::Kind::completed: return generator_->ended_upto() >= next_id_ - 1;
+  }
+  return false;
+}
+
+WaitResult Manipulator::waitfor(const Event& event, std::chrono::nanoseconds timeout) {
+  const bool reached =
+      happened(event) ||
+      session_.wait_until([&](const rtc::How&) { return happened(event); }, timeout);
+  drain();
+  if (!reached) return session_.controlling() ? WaitResult::timeout : WaitResult::session_ended;
+  if (event.kind == Event::Kind::motion_start || event.kind == Event::Kind::motion_end) {
+    if (failed_ids_.count(event.id) != 0) return WaitResult::failed;
+  }
+  if (event.kind == Event::Kind::completed && !failed_ids_.empty() &&
+      *failed_ids_.rbegin() == next_id_ - 1) {
+    return WaitResult::failed;
+  }
+  return WaitResult::reached;
+}
+
+void Manipulator::drain() {
+  while (auto e = generator_->next_event()) {
+    if (e->kind == EventKind::failed || e->kind == EventKind::cancelled) {
+      failures_.push_back(*e);
+      failed_ids_.insert(e->id);
+    }
+    pending_events_.push_back(*e);
+  }
+  // A program that never takes its events keeps the newest few thousand.
+  if (pending_events_.size() > 8192) {
+    pending_events_.erase(pending_events_.begin(), pending_events_.begin() + 4096);
+  }
+}
+
+const std::vector<MotionEvent>& Manipulator::failures() {
+  drain();
+  return failures_;
+}
+
+std::vector<MotionEvent> Manipulator::take_events() {
+  drain();
+  return std::exchange(pending_events_, {});
+}
+
+}  // namespace rccx::rccl

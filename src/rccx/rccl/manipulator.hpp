@@ -1,0 +1,146 @@
+// The RCCL of one arm (thesis 2.4): the planning level's motion calls over an RTC session whose
+// control function is the trajectory generator.
+//
+//   rccl::Manipulator arm(session);            // rccl_open: the session is open already
+//   arm.start();                               // rccl_control: the generator runs every sample
+//   arm.set_velocity(0.1, 100_deg);            // setvel: m/s, rad/s
+//   auto m = arm.move(arm.park());             // queues a request and returns at once
+//   arm.waitfor(m.end());                      // waitfor(park->end)
+//   arm.set_mode(rccl::Mode::cartesian);       // setmod('c')
+//   for (auto& p : corners) arm.move(p);       // transitions join the queued segments
+//   arm.waitfor(arm.completed());              // waitfor(completed)
+//
+// Requests reach the sample loop through a lock-free queue; events (start, end, failure) come
+// back the same way. Waiting lets simulated time run, so a simulated program is deterministic.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <set>
+#include <stdexcept>
+#include <string_view>
+#include <vector>
+
+#include "rccx/kinematics/kinematics.hpp"
+#include "rccx/rccl/trajectory.hpp"
+#include "rccx/rtc/session.hpp"
+
+namespace rccx::rccl {
+
+/// A motion that cannot be queued: a goal known now to be out of reach or out of limits, a full
+/// queue, a setting out of range, or a call before start(). Nothing was queued or changed.
+class MotionError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// Something a program may wait for.
+struct Event {
+  enum class Kind : std::uint8_t { motion_start, motion_end, position_end, completed };
+  Kind kind = Kind::completed;
+  std::uint64_t id = 0;                ///< motion_start / motion_end
+  const Position* position = nullptr;  ///< position_end: every queued motion to it has ended
+};
+
+/// A queued motion.
+struct Motion {
+  std::uint64_t id = 0;
+  [[nodiscard]] Event start() const noexcept { return {Event::Kind::motion_start, id, nullptr}; }
+  [[nodiscard]] Event end() const noexcept { return {Event::Kind::motion_end, id, nullptr}; }
+};
+
+enum class WaitResult : std::uint8_t {
+  reached,        ///< the event happened
+  failed,         ///< the motion waited for failed or was cancelled (see failures())
+  timeout,        ///< the timeout passed first
+  session_ended,  ///< control ended (see the session's termination)
+};
+std::string_view to_string(WaitResult r) noexcept;
+
+class Manipulator {
+ public:
+  /// The arm of `session` (its driver's robot), with its own kinematics solver.
+  explicit Manipulator(rtc::Session& session);
+  /// Stops control when it was started here.
+  ~Manipulator();
+  Manipulator(const Manipulator&) = delete;
+  Manipulator& operator=(const Manipulator&) = delete;
+
+  /// rccl_control: the trajectory generator becomes the session's control function (f2),
+  /// starting at rest where the arm stands. Throws rtc::SessionError when control is active.
+  void start();
+  /// Stops the generator (rtc release); the arm holds. Returns how control ended.
+  rtc::Termination stop_control();
+
+  // --- Settings for the motions queued from now on --------------------------------------------
+  void set_mode(Mode mode) noexcept { settings_.mode = mode; }
+  /// setvel: tool translation (m/s) and rotation (rad/s) speeds, both > 0.
+  void set_velocity(double translation_m_per_s, double rotation_rad_per_s);
+  /// settime: segment duration (s; 0 = from the speeds) and transition time (s, > 0).
+  void set_segment_time(double seconds);
+  void set_transition_time(double seconds);
+  /// The configuration to reach the next goals in ("lun", "n" ...); empty keeps the present one.
+  void set_configuration(std::string_view name);
+  [[nodiscard]] const MotionSettings& settings() const noexcept { return settings_; }
+
+  // --- Motions ----------------------------------------------------------------------------------
+  /// Queues a motion to `position` and returns at once. A position whose transforms are all
+  /// constant or hold is checked now: throws MotionError (queuing nothing) when no
+  /// configuration reaches it within limits.
+  Motion move(const PositionPtr& position);
+  /// RCCL's stop(): stay where the previous motion ends for `seconds`.
+  Motion dwell(double seconds);
+  /// Stops smoothly where the arm is and cancels everything queued.
+  void halt();
+  /// The robot's park position (its ready pose, in joints).
+  [[nodiscard]] const PositionPtr& park() const noexcept { return park_; }
+
+  // --- Synchronisation --------------------------------------------------------------------------
+  [[nodiscard]] static Event completed() noexcept { return {}; }
+  [[nodiscard]] static Event ended(const PositionPtr& p) noexcept {
+    return {Event::Kind::position_end, 0, p.get()};
+  }
+  /// Waits for `event` (in simulated time: runs the samples until then).
+  WaitResult waitfor(const Event& event,
+                     std::chrono::nanoseconds timeout = std::chrono::hours(24 * 365));
+  /// True when `event` has happened.
+  [[nodiscard]] bool happened(const Event& event) const noexcept;
+
+  // --- What happened ----------------------------------------------------------------------------
+  /// Failures and cancellations so far (collected from the generator's events).
+  [[nodiscard]] const std::vector<MotionEvent>& failures();
+  /// Every event the generator sent since the last call (started, ended, failed, cancelled).
+  std::vector<MotionEvent> take_events();
+  /// How motion `m` followed its path (once it has ended).
+  [[nodiscard]] SegmentReport report(const Motion& m) const noexcept {
+    return generator_->report(m.id);
+  }
+  [[nodiscard]] std::uint64_t last_queued() const noexcept { return next_id_ - 1; }
+
+  [[nodiscard]] rtc::Session& session() noexcept { return session_; }
+  [[nodiscard]] const kin::Kinematics& kinematics() const noexcept { return *kinematics_; }
+  [[nodiscard]] TrajectoryGenerator& generator() noexcept { return *generator_; }
+
+ private:
+  Motion submit(MotionRequest r, const PositionPtr& keep);
+  void drain();
+  void check_reachable(const Position& p) const;
+
+  rtc::Session& session_;
+  std::unique_ptr<kin::Kinematics> kinematics_;
+  std::unique_ptr<TrajectoryGenerator> generator_;
+  kin::JointVector lower_;
+  MotionSettings settings_;
+  PositionPtr park_;
+  std::vector<PositionPtr> keep_;  ///< positions the loop may still point to
+  std::uint64_t next_id_ = 1;
+  bool started_ = false;
+  bool first_sample_ = true;  ///< loop side: reset the generator at the arm's position
+  std::vector<MotionEvent> failures_;
+  std::vector<MotionEvent> pending_events_;
+  std::set<std::uint64_t> failed_ids_;
+};
+
+}  // namespace rccx::rccl

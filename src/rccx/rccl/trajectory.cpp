@@ -1,0 +1,704 @@
+#include "rccx/rccl/trajectory.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "rccx/rccl/paul_transition.hpp"
+
+namespace rccx::rccl {
+namespace {
+
+using kin::JointVector;
+
+/// The quintic smoothstep of Lloyd and Hayward's blend: s(0) = 0, s(1) = 1, s' and s'' zero
+/// at both ends.
+constexpr double smoothstep(double u) noexcept {
+  u = std::clamp(u, 0.0, 1.0);
+  return u * u * u * (10.0 + u * (-15.0 + 6.0 * u));
+}
+
+/// Peak acceleration of a transition per unit change of velocity and unit 1/tau: Paul's quartic
+/// 0.75, the smoothstep blend of two lines 1.875 (its (2u - 1) s(u) has |d2/du2| <= 7.5 at
+/// u = 1/2, and d/dt = d/du / 2 tau).
+constexpr double kPaulPeak = 0.75;
+constexpr double kSmoothPeak = 1.875;
+
+/// The pose a fraction s of the way from a to b: position on the line, rotation about the
+/// fixed axis of a⁻¹ b.
+math::Transform interpolate(const math::Transform& a, const math::Transform& b,
+                            double s) noexcept {
+  const math::Rot3 rel = a.R.transposed() * b.R;
+  math::Vec3 axis;
+  double angle = 0.0;
+  rel.to_axis_angle(axis, angle);
+  return {a.R * math::Rot3::about(axis, s * angle), a.p + (b.p - a.p) * s};
+}
+
+double rotation_angle(const math::Rot3& r) noexcept {
+  math::Vec3 axis;
+  double angle = 0.0;
+  r.to_axis_angle(axis, angle);
+  return angle;
+}
+
+/// Distance from point p to the segment [a, b], m.
+double distance_to_segment(const math::Vec3& p, const math::Vec3& a, const math::Vec3& b) noexcept {
+  const math::Vec3 ab = b - a;
+  const double len2 = dot(ab, ab);
+  const double s = len2 > 0.0 ? std::clamp(dot(p - a, ab) / len2, 0.0, 1.0) : 0.0;
+  return (p - (a + ab * s)).norm();
+}
+
+/// Formats into a fixed buffer: no allocation, for messages made in the sample loop.
+template <class... Args>
+std::array<char, kEventText> text(fmt::format_string<Args...> f, Args&&... args) noexcept {
+  std::array<char, kEventText> to{};
+  try {
+    const auto r = fmt::format_to_n(to.data(), kEventText - 1, f, std::forward<Args>(args)...);
+    *r.out = '\0';
+  } catch (...) {
+    to[0] = '\0';
+  }
+  return to;
+}
+
+}  // namespace
+
+std::string_view to_string(Mode m) noexcept {
+  return m == Mode::joint ? "joint" : "cartesian";
+}
+
+std::string_view to_string(EventKind k) noexcept {
+  switch (k) {
+    case EventKind::started: return "started";
+    case EventKind::ended: return "ended";
+    case EventKind::failed: return "failed";
+    case EventKind::cancelled: return "cancelled";
+  }
+  return "?";
+}
+
+std::string_view MotionEvent::message() const noexcept {
+  return {text.data()};
+}
+
+TrajectoryGenerator::TrajectoryGenerator(const kin::Kinematics& kinematics,
+                                         GeneratorOptions options)
+    : kin_(kinematics),
+      options_(std::move(options)),
+      lower_(kinematics.model().lower()),
+      upper_(kinematics.model().upper()) {
+  const auto& joints = kin_.model().joints;
+  const std::size_t n = kin_.dof();
+  if (options_.max_velocity.size() != n) {
+    options_.max_velocity = JointVector(n);
+    for (std::size_t j = 0; j < n; ++j) options_.max_velocity[j] = joints[j].max_velocity;
+  }
+  if (options_.max_acceleration.size() != n) {
+    options_.max_acceleration = JointVector(n);
+    for (std::size_t j = 0; j < n; ++j) {
+      options_.max_acceleration[j] = options_.max_velocity[j] / kDefaultAccelerationTime_s;
+    }
+  }
+  reset(kin_.model().ready(), 0.0);
+}
+
+// --- Planning level ------------------------------------------------------------------------------
+
+bool TrajectoryGenerator::submit(const MotionRequest& request) noexcept {
+  return requests_.push(request);
+}
+
+std::optional<MotionEvent> TrajectoryGenerator::next_event() noexcept {
+  MotionEvent e;
+  if (events_.pop(e)) return e;
+  return std::nullopt;
+}
+
+SegmentReport TrajectoryGenerator::report(std::uint64_t id) const noexcept {
+  const SegmentReport& r = reports_[id % kReports];
+  return r.id == id ? r : SegmentReport{};
+}
+
+// --- Segment values ------------------------------------------------------------------------------
+
+double TrajectoryGenerator::fraction(const Segment& s, double t) const noexcept {
+  return (t - s.ts) / s.T;
+}
+
+void TrajectoryGenerator::pose_at(const Segment& s, const SampleContext& ctx, double r,
+                                  Pose& out) const {
+  if (s.position->in_joints()) {
+    out.goal = s.fixed_goal;
+    out.tool = math::Transform::identity();
+  } else {
+    s.position->evaluate(ctx, s.holds, out.goal, out.tool);
+  }
+  out.frame = out.goal * s.drive.at(r);
+  out.t6 = out.frame * out.tool.inverse();
+}
+
+bool TrajectoryGenerator::solve(const Segment& s, const math::Transform& t6,
+                                const JointVector& near, JointVector& q,
+                                kin::IkStatus& why) const noexcept {
+  kin::IkOptions o;
+  if (s.has_configuration) o.configuration = s.configuration;
+  o.near = near;
+  const kin::IkResult r = kin_.inverse(t6, o);
+  if (!r) {
+    why = r.status;
+    return false;
+  }
+  q = r.q;
+  return true;
+}
+
+bool TrajectoryGenerator::segment_value(const Segment& s, const SampleContext& ctx, double t,
+                                        const JointVector& near, JointVector& q,
+                                        kin::IkStatus& why, Pose* pose) const {
+  switch (s.kind) {
+    case Segment::Kind::rest: q = s.q1; return true;
+    case Segment::Kind::joint: {
+      const double r = fraction(s, t);
+      q = s.q0;
+      for (std::size_t j = 0; j < q.size(); ++j) q[j] += (s.q1[j] - s.q0[j]) * r;
+      return true;
+    }
+    case Segment::Kind::cartesian: {
+      Pose p;
+      pose_at(s, ctx, drive_fraction(s, t), p);
+      if (pose) *pose = p;
+      return solve(s, p.t6, near, q, why);
+    }
+  }
+  return false;
+}
+
+// --- Building segments -----------------------------------------------------------------------------
+
+bool TrajectoryGenerator::build(const MotionRequest& r, const SampleContext& ctx, double t_via) {
+  const std::size_t n = kin_.dof();
+  Segment s;
+  s.id = r.id;
+  s.position = r.position;
+  s.settings = r.settings;
+  s.ts = t_via;
+  kin::IkStatus why = kin::IkStatus::ok;
+
+  // Where the arm will be at the via point: the present segment's end.
+  JointVector qB = last_q_;
+  math::Transform t6B;
+  if (cur_.kind == Segment::Kind::cartesian) {
+    Pose p;
+    pose_at(cur_, ctx, 1.0, p);
+    t6B = p.t6;
+    if (!solve(cur_, t6B, last_q_, qB, why)) qB = last_q_;
+  } else {
+    qB = cur_.q1;
+    t6B = kin_.forward(qB);
+  }
+  s.q0 = qB;
+
+  if (r.kind == RequestKind::dwell) {
+    s.kind = Segment::Kind::joint;
+    s.q1 = qB;
+    s.T = std::max(r.dwell_s, options_.period_s);
+    s.stop_tau = std::max(options_.period_s, 0.5 * s.settings.transition_time_s);
+    next_ = s;
+    has_next_ = true;
+    return true;
+  }
+
+  const Position& pos = *r.position;
+  const char* name = pos.name().c_str();
+  if (pos.in_joints()) {
+    const JointVector& g = pos.joint_values();
+    if (g.size() != n) {
+      fail(r.id, ctx, kin::IkStatus::bad_input, 0,
+           text("position {} has {} joint values, the robot {}", name, g.size(), n));
+      return false;
+    }
+    const int out = kin_.model().first_joint_outside_limits(g, kin::kLimitTolerance);
+    if (out >= 0) {
+      fail(r.id, ctx, kin::IkStatus::joint_limits, out + 1,
+           text("position {}: joint {} is outside its limits", name, out + 1));
+      return false;
+    }
+    s.fixed_goal = kin_.forward(g);
+  } else {
+    pos.latch(s.holds);
+  }
+
+  // The configuration: the one asked for, else the one the arm is in.
+  if (!kin_.configuration_names().empty()) {
+    s.has_configuration = true;
+    s.configuration = s.settings.configuration >= 0
+                          ? kin::Configuration{static_cast<std::uint8_t>(s.settings.configuration)}
+                          : kin_.configuration_of(qB);
+  }
+  Pose goal;
+  pose_at(s, ctx, 1.0, goal);  // drive is identity so far: frame = goal
+  const math::Transform frameB = t6B * goal.tool;
+  const math::Transform offset = goal.goal.inverse_times(frameB);
+  // Time from the tool's speeds along the motion (RCCL computes it so in both modes).
+  const double by_speed =
+      std::max(offset.p.norm() / std::max(s.settings.translation_m_per_s, 1e-9),
+               rotation_angle(offset.R) / std::max(s.settings.rotation_rad_per_s, 1e-9));
+  double by_joints = 0.0;  // the time the joints' top speeds allow, s
+  double by_acceleration = 0.0;
+  const auto joint_time = [&](const JointVector& a, const JointVector& b, double scale) {
+    for (std::size_t j = 0; j < n; ++j) {
+      const double d = std::abs(b[j] - a[j]) * scale;
+      by_joints = std::max(by_joints, d / (kPlanningSpeedFraction * options_.max_velocity[j]));
+      // Room for the transitions in and out at the acceleration bound: each needs up to
+      // tau = 0.75 dv / a with dv up to 2 v, v = d / T, and together they must fit in T.
+      by_acceleration = std::max(by_acceleration, std::sqrt(3.0 * d / options_.max_acceleration[j]));
+    }
+  };
+
+  if (s.settings.mode == Mode::joint) {
+    s.kind = Segment::Kind::joint;
+    if (pos.in_joints()) {
+      s.q1 = pos.joint_values();
+    } else if (!solve(s, goal.t6, qB, s.q1, why)) {
+      fail(r.id, ctx, why, 0, text("position {} cannot be reached in joint mode: {}", name,
+                                          kin::describe(why)));
+      return false;
+    }
+    joint_time(s.q0, s.q1, 1.0);
+  } else {
+    s.kind = Segment::Kind::cartesian;
+    s.drive = math::DriveTransform(offset, math::Transform::identity());
+    // Walk the line before moving: a point out of reach or out of limits, or a joint that would
+    // need more than its speed, is reported now rather than in the middle of the motion.
+    constexpr int kChecks = 16;
+    JointVector q_prev = qB, q;
+    for (int k = 1; k <= kChecks; ++k) {
+      Pose p;
+      pose_at(s, ctx, static_cast<double>(k) / kChecks, p);
+      if (!solve(s, p.t6, q_prev, q, why)) {
+        fail(r.id, ctx, why, 0,
+             text("the straight line to {} leaves the workspace {:.0f}% of the way: {}",
+                         name, 100.0 * k / kChecks, kin::describe(why)));
+        return false;
+      }
+      joint_time(q_prev, q, kChecks);
+      q_prev = q;
+    }
+    s.q1 = q;
+  }
+  s.T = s.settings.segment_time_s > 0.0 ? s.settings.segment_time_s : by_speed;
+  s.T = std::max({s.T, by_joints, by_acceleration, s.settings.transition_time_s,
+                  2.0 * options_.period_s});
+  s.stop_tau = std::max(options_.period_s, 0.5 * s.settings.transition_time_s);
+  for (std::size_t j = 0; j < n; ++j) {
+    const double v = std::abs(s.q1[j] - s.q0[j]) / s.T;
+    s.stop_tau = std::max(s.stop_tau, kPaulPeak * v / options_.max_acceleration[j]);
+  }
+  s.stop_tau = std::min(s.stop_tau, 0.5 * s.T);
+  next_ = s;
+  has_next_ = true;
+  return true;
+}
+
+// --- Transitions ---------------------------------------------------------------------------------
+
+TrajectoryGenerator::Blend TrajectoryGenerator::blend_between(const Segment& a,
+                                                              const Segment* b) const noexcept {
+  using K = Segment::Kind;
+  const bool a_linear = a.kind == K::joint || a.kind == K::rest;
+  if (b == nullptr) return a.kind == K::cartesian ? Blend::paul_r_out : Blend::paul_joint;
+  if (a_linear && b->kind != K::cartesian) return Blend::paul_joint;
+  if (a.kind == K::rest && b->kind == K::cartesian) return Blend::paul_r_in;
+  if (a.kind == K::cartesian && b->kind == K::cartesian) return Blend::smooth_pose;
+  return Blend::smooth_joint;
+}
+
+double TrajectoryGenerator::transition_tau(const Segment& a, const Segment& b, Blend blend,
+                                           double tB, const SampleContext& ctx) const {
+  const double P = options_.period_s;
+  const Segment& owner = a.kind == Segment::Kind::rest ? b : a;
+  double tau = std::max(P, 0.5 * owner.settings.transition_time_s);
+  // The change of joint velocity across the via point, from values one period apart.
+  JointVector qa0, qa1, qb0, qb1;
+  kin::IkStatus why;
+  if (!segment_value(a, ctx, tB - P, last_q_, qa0, why) ||
+      !segment_value(a, ctx, tB, last_q_, qa1, why) ||
+      !segment_value(b, ctx, tB, qa1, qb0, why) || !segment_value(b, ctx, tB + P, qb0, qb1, why)) {
+    return tau;
+  }
+  const double peak = blend == Blend::smooth_pose || blend == Blend::smooth_joint ? kSmoothPeak
+                                                                                   : kPaulPeak;
+  for (std::size_t j = 0; j < kin_.dof(); ++j) {
+    const double dv = ((qb1[j] - qb0[j]) - (qa1[j] - qa0[j])) / P;
+    tau = std::max(tau, peak * std::abs(dv) / options_.max_acceleration[j]);
+  }
+  // The transition may not reach back past the start of a's straight part nor beyond b's.
+  if (a.kind != Segment::Kind::rest) tau = std::min(tau, std::max(P, tB - (a.ts + a.tau_in)));
+  if (b.kind != Segment::Kind::rest) tau = std::min(tau, std::max(P, 0.5 * b.T));
+  return tau;
+}
+
+void TrajectoryGenerator::begin_transition(const SampleContext& ctx, double tB, double tau,
+                                           Blend blend, bool to_next) noexcept {
+  tr_.active = true;
+  tr_.tB = tB;
+  tr_.tau = tau;
+  tr_.blend = blend;
+  tr_.to_next = to_next;
+  have_last_frame_ = false;
+  if (to_next) {
+    next_.tau_in = tau;
+    started_.store(next_.id, std::memory_order_release);
+    emit(EventKind::started, next_.id, ctx);
+    SegmentReport& rep = reports_[next_.id % kReports];
+    rep = SegmentReport{};
+    rep.id = next_.id;
+    rep.mode = next_.kind == Segment::Kind::cartesian ? Mode::cartesian : Mode::joint;
+    rep.start_s = ctx.t_s;
+    rep.duration_s = next_.T;
+  }
+}
+
+void TrajectoryGenerator::finish_transition(const SampleContext& ctx) {
+  tr_.active = false;
+  if (tr_.to_next) {
+    end_motion(cur_, ctx);
+    cur_ = next_;
+    has_next_ = false;
+    return;
+  }
+  // Came to rest at the end of cur_: exactly its end point, or tracking its moving goal.
+  end_motion(cur_, ctx);
+  if (cur_.kind == Segment::Kind::cartesian && cur_.position->moves()) {
+    cur_.resting = true;
+    cur_.id = 0;
+    return;
+  }
+  JointVector q = cur_.q1;
+  kin::IkStatus why;
+  if (cur_.kind == Segment::Kind::cartesian) {
+    Pose p;
+    pose_at(cur_, ctx, 1.0, p);
+    if (!solve(cur_, p.t6, last_q_, q, why)) q = last_q_;
+  }
+  rest_at(q);
+}
+
+bool TrajectoryGenerator::value(const SampleContext& ctx, double t, JointVector& q,
+                                kin::IkStatus& why) {
+  if (!tr_.active) {
+    Pose p;
+    const bool ok = segment_value(cur_, ctx, t, last_q_, q, why, &p);
+    if (ok && cur_.kind == Segment::Kind::cartesian && !cur_.resting) {
+      pose_ = p;
+      pose_valid_ = true;
+    }
+    return ok;
+  }
+  const Segment& a = cur_;
+  const Segment& b = tr_.to_next ? next_ : cur_;
+  const double tB = tr_.tB, tau = tr_.tau;
+  switch (tr_.blend) {
+    case Blend::paul_joint: {
+      // Per coordinate, from a's line onto b's (or to rest at the via point).
+      JointVector qa, qB, qc;
+      const Segment stop = rest_of(a);
+      const Segment& to = tr_.to_next ? b : stop;
+      if (!segment_value(a, ctx, tB - tau, last_q_, qa, why) ||
+          !segment_value(a, ctx, tB, last_q_, qB, why) ||
+          !segment_value(to, ctx, tB + tau, qB, qc, why)) {
+        return false;
+      }
+      q = qB;
+      for (std::size_t j = 0; j < q.size(); ++j) {
+        q[j] = paul_transition(qB[j], qa[j] - qB[j], qc[j] - qB[j], tau, tau, t - tB).q;
+      }
+      return true;
+    }
+    case Blend::paul_r_in: {
+      const double r = paul_transition(0.0, 0.0, tau / b.T, tau, tau, t - tB).q;
+      Pose p;
+      pose_at(b, ctx, r, p);
+      return solve(b, p.t6, last_q_, q, why);
+    }
+    case Blend::paul_r_out: {
+      const double r = paul_transition(1.0, -tau / a.T, 0.0, tau, tau, t - tB).q;
+      Pose p;
+      pose_at(a, ctx, r, p);
+      return solve(a, p.t6, last_q_, q, why);
+    }
+    case Blend::smooth_pose: {
+      Pose pa, pb;
+      pose_at(a, ctx, drive_fraction(a, t), pa);
+      pose_at(b, ctx, drive_fraction(b, t), pb);
+      const double s = smoothstep((t - (tB - tau)) / (2.0 * tau));
+      return solve(s < 0.5 ? a : b, interpolate(pa.t6, pb.t6, s), last_q_, q, why);
+    }
+    case Blend::smooth_joint: {
+      JointVector qa, qb;
+      if (!segment_value(a, ctx, t, last_q_, qa, why) ||
+          !segment_value(b, ctx, t, last_q_, qb, why)) {
+        return false;
+      }
+      const double s = smoothstep((t - (tB - tau)) / (2.0 * tau));
+      q = qa;
+      for (std::size_t j = 0; j < q.size(); ++j) q[j] += s * (qb[j] - qa[j]);
+      return true;
+    }
+  }
+  return false;
+}
+
+TrajectoryGenerator::Segment TrajectoryGenerator::rest_of(const Segment& a) const noexcept {
+  Segment r;
+  r.kind = Segment::Kind::rest;
+  r.q1 = a.kind == Segment::Kind::joint ? a.q1 : last_q_;
+  return r;
+}
+
+// --- Ending, failing, halting --------------------------------------------------------------------
+
+void TrajectoryGenerator::emit(EventKind kind, std::uint64_t id, const SampleContext& ctx,
+                               kin::IkStatus status, int joint, std::string_view text) noexcept {
+  MotionEvent e;
+  e.kind = kind;
+  e.id = id;
+  e.t_s = ctx.t_s;
+  e.sample = ctx.sample;
+  e.status = status;
+  e.joint = joint;
+  const std::size_t len = std::min(text.size(), kEventText - 1);
+  std::copy_n(text.data(), len, e.text.data());
+  e.text[len] = '\0';
+  events_.push(e);  // a full event queue drops the event: the counters still tell the story
+}
+
+void TrajectoryGenerator::end_motion(const Segment& s, const SampleContext& ctx) noexcept {
+  if (s.id == 0) return;
+  SegmentReport& rep = reports_[s.id % kReports];
+  if (rep.id == s.id) rep.end_s = ctx.t_s;
+  if (s.position != nullptr) s.position->pending_ends.fetch_sub(1, std::memory_order_acq_rel);
+  emit(EventKind::ended, s.id, ctx);
+  ended_.store(s.id, std::memory_order_release);
+}
+
+void TrajectoryGenerator::fail(std::uint64_t id, const SampleContext& ctx, kin::IkStatus status,
+                               int joint, const Text& text) noexcept {
+  SegmentReport& rep = reports_[id % kReports];
+  rep.id = id;
+  rep.failed = true;
+  rep.end_s = ctx.t_s;
+  emit(EventKind::failed, id, ctx, status, joint, std::string_view(text.data()));
+  // Everything from the motion running now to the last one queued ends here.
+  std::uint64_t last = id;
+  const auto cancel = [&](const Segment& s) {
+    if (s.id == 0) return;
+    if (s.id != id) emit(EventKind::cancelled, s.id, ctx);
+    if (s.position != nullptr) s.position->pending_ends.fetch_sub(1, std::memory_order_acq_rel);
+    last = std::max(last, s.id);
+  };
+  if (cur_.kind != Segment::Kind::rest) cancel(cur_);
+  if (has_next_) cancel(next_);
+  if (waiting_) {
+    Segment w;
+    w.id = waiting_->id;
+    w.position = waiting_->position;
+    cancel(w);
+    waiting_.reset();
+  }
+  MotionRequest r;
+  while (requests_.pop(r)) {
+    Segment w;
+    w.id = r.id;
+    w.position = r.position;
+    cancel(w);
+  }
+  has_next_ = false;
+  tr_.active = false;
+  started_.store(std::max(started_.load(), last), std::memory_order_release);
+  ended_.store(last, std::memory_order_release);
+  start_halt(ctx);
+}
+
+void TrajectoryGenerator::start_halt(const SampleContext& ctx) noexcept {
+  const double P = options_.period_s;
+  halt_ = Halt{};
+  halt_.active = true;
+  halt_.t0 = last_t_;
+  halt_.q0 = last_q_;
+  halt_.v0 = last_q_;
+  halt_.stop_time = last_q_;
+  double Ts = 0.0;  // one time for all joints keeps the joint-space path straight
+  for (std::size_t j = 0; j < last_q_.size(); ++j) {
+    halt_.v0[j] = (last_q_[j] - prev_q_[j]) / P;
+    Ts = std::max(Ts, std::abs(halt_.v0[j]) / options_.max_acceleration[j]);
+  }
+  for (std::size_t j = 0; j < last_q_.size(); ++j) {
+    const double v = halt_.v0[j];
+    double stop = Ts;
+    // Stopping distance v Ts / 2; a joint that would pass its limit stops harder, at it.
+    const double room = v > 0 ? upper_[j] - last_q_[j] : last_q_[j] - lower_[j];
+    if (std::abs(v) * Ts / 2.0 > room) stop = 2.0 * std::max(room, 0.0) / std::abs(v);
+    halt_.stop_time[j] = stop;
+  }
+  (void)ctx;
+}
+
+void TrajectoryGenerator::halt_value(double t, JointVector& q) noexcept {
+  q = halt_.q0;
+  bool moving = false;
+  for (std::size_t j = 0; j < q.size(); ++j) {
+    const double Ts = halt_.stop_time[j];
+    if (!(Ts > 0.0)) continue;
+    const double dt = std::min(t - halt_.t0, Ts);
+    q[j] += halt_.v0[j] * (dt - dt * dt / (2.0 * Ts));
+    moving = moving || t - halt_.t0 < Ts;
+  }
+  if (!moving) {
+    halt_.active = false;
+    rest_at(q);
+  }
+}
+
+void TrajectoryGenerator::rest_at(const JointVector& q) noexcept {
+  cur_ = Segment{};
+  cur_.kind = Segment::Kind::rest;
+  cur_.q1 = q;
+  pose_valid_ = false;
+}
+
+void TrajectoryGenerator::reset(const JointVector& q, double t_s) noexcept {
+  waiting_.reset();
+  has_next_ = false;
+  tr_ = Transition{};
+  halt_ = Halt{};
+  halt_requested_.store(false);
+  rest_at(q);
+  last_q_ = prev_q_ = q;
+  last_t_ = t_s - options_.period_s;
+}
+
+bool TrajectoryGenerator::at_rest() const noexcept {
+  return !halt_.active && !tr_.active && !has_next_ && !waiting_ &&
+         (cur_.kind == Segment::Kind::rest || cur_.resting);
+}
+
+std::uint64_t TrajectoryGenerator::step(const SampleContext& ctx, const JointVector* measured,
+                                        JointVector& q) {
+  const double t = ctx.t_s;
+  const double P = options_.period_s;
+  const double eps = 1e-9;
+  pose_valid_ = false;
+
+  if (halt_requested_.exchange(false, std::memory_order_acq_rel) && !at_rest()) {
+    const std::uint64_t id = cur_.id != 0 ? cur_.id : (has_next_ ? next_.id : 0);
+    fail(id, ctx, kin::IkStatus::ok, 0, text("halted by the program"));
+  }
+  if (!waiting_) {
+    MotionRequest r;
+    if (requests_.pop(r)) waiting_ = r;
+  }
+
+  if (!halt_.active && !tr_.active) {
+    const bool resting = cur_.kind == Segment::Kind::rest || cur_.resting;
+    if (resting && waiting_) {
+      // From rest: the transition begins now; the straight part tau later.
+      if (build(*waiting_, ctx, t)) {
+        waiting_.reset();
+        const Blend blend = blend_between(cur_, &next_);
+        const double tau = transition_tau(cur_, next_, blend, t, ctx);
+        next_.ts = t + tau;
+        begin_transition(ctx, t + tau, tau, blend, true);
+      }
+    } else if (!resting) {
+      const double te = cur_.ts + cur_.T;
+      if (!has_next_ && waiting_ && t < te - cur_.stop_tau - eps) {
+        if (build(*waiting_, ctx, te)) {
+          waiting_.reset();
+          const Blend blend = blend_between(cur_, &next_);
+          next_tau_ = transition_tau(cur_, next_, blend, te, ctx);
+          // Decided late: the window must not have begun already.
+          next_tau_ = std::min(next_tau_, te - t);
+        }
+      }
+      if (has_next_ && t >= te - next_tau_ - eps) {
+        begin_transition(ctx, te, next_tau_, blend_between(cur_, &next_), true);
+      } else if (!has_next_ && t >= te - cur_.stop_tau - eps) {
+        begin_transition(ctx, te, cur_.stop_tau, blend_between(cur_, nullptr), false);
+      }
+    }
+  }
+  if (tr_.active && t >= tr_.tB + tr_.tau - eps) finish_transition(ctx);
+
+  kin::IkStatus why = kin::IkStatus::ok;
+  if (halt_.active) {
+    halt_value(t, q);
+  } else if (!value(ctx, t, q, why)) {
+    const std::uint64_t id = tr_.active && tr_.to_next ? next_.id : cur_.id;
+    fail(id, ctx, why, 0,
+         text("the path cannot be followed at t = {:.3f} s: {}", t, kin::describe(why)));
+    halt_value(t, q);
+  } else {
+    // Never out of limits, never faster than a joint may go: stop instead.
+    for (std::size_t j = 0; j < q.size(); ++j) {
+      const double speed = std::abs(q[j] - last_q_[j]) / P;
+      const bool out = !(q[j] >= lower_[j] - kin::kLimitTolerance &&
+                         q[j] <= upper_[j] + kin::kLimitTolerance);
+      const bool fast = !(speed <= options_.max_velocity[j] * (1.0 + 1e-6));
+      if (out || fast) {
+        const std::uint64_t id = tr_.active && tr_.to_next ? next_.id : cur_.id;
+        fail(id, ctx, out ? kin::IkStatus::joint_limits : kin::IkStatus::singular,
+             static_cast<int>(j) + 1,
+             out ? text("joint {} would leave its limits at t = {:.3f} s", j + 1, t)
+                 : text("joint {} would move at {:.3f}/s, above its top speed {:.3f}/s "
+                               "(near a singularity?)",
+                               j + 1, speed, options_.max_velocity[j]));
+        halt_value(t, q);
+        break;
+      }
+    }
+  }
+  for (std::size_t j = 0; j < q.size(); ++j) q[j] = std::clamp(q[j], lower_[j], upper_[j]);
+  record(ctx, q, measured);
+  prev_q_ = last_q_;
+  last_q_ = q;
+  last_t_ = t;
+  if (tr_.active && tr_.to_next) return next_.id;
+  return cur_.id;
+}
+
+void TrajectoryGenerator::record(const SampleContext& ctx, const JointVector& q,
+                                 const JointVector* measured) noexcept {
+  (void)q;
+  if (tr_.active || halt_.active || cur_.id == 0) return;
+  SegmentReport& rep = reports_[cur_.id % kReports];
+  if (rep.id != cur_.id || !pose_valid_) return;
+  const double P = options_.period_s;
+  // The line as it stands for the present goal: from the start to the goal, in base frame.
+  const math::Vec3 from = (pose_.goal * cur_.drive.at(0.0)).p;
+  const math::Vec3 to = pose_.goal.p;
+  ++rep.straight_samples;
+  rep.max_commanded_path_error_m =
+      std::max(rep.max_commanded_path_error_m, distance_to_segment(pose_.frame.p, from, to));
+  if (have_last_frame_) {
+    rep.peak_tool_speed_m_per_s =
+        std::max(rep.peak_tool_speed_m_per_s, (pose_.frame.p - last_frame_p_).norm() / P);
+  }
+  // The measured arm lags the command by the pipeline (about two periods): judge it once the
+  // transition in is that far behind.
+  if (measured != nullptr && measured->size() == q.size() &&
+      ctx.t_s >= cur_.ts + cur_.tau_in + 3.0 * P) {
+    const math::Transform frame = kin_.forward(*measured) * pose_.tool;
+    rep.max_measured_path_error_m =
+        std::max(rep.max_measured_path_error_m, distance_to_segment(frame.p, from, to));
+    const double c = std::clamp(dot(frame.R.a, pose_.frame.R.a), -1.0, 1.0);
+    rep.max_approach_error_rad = std::max(rep.max_approach_error_rad, std::acos(c));
+  }
+  last_frame_p_ = pose_.frame.p;
+  have_last_frame_ = true;
+}
+
+}  // namespace rccx::rccl

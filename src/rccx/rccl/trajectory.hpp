@@ -1,0 +1,247 @@
+// The trajectory generator (thesis 2.4.2, RCCL's setpoint): the RTC control function that turns
+// the queue of motion requests into one joint setpoint per sample.
+//
+// Segments run in joint mode (joints interpolated linearly between the solved end points) or in
+// Cartesian mode (the tool frame F = T6 TOOL moves on a straight line, F(t) = G(t) D(r): G the
+// goal, re-evaluated every sample so that a moving goal is tracked, D(r) Paul's drive transform
+// from the start, expressed in the goal's frame, to the goal; the inverse kinematics solved
+// every sample in the configuration the segment started in).
+//
+// Between consecutive segments, and when the arm starts from rest or comes to rest, a
+// transition of 2 tau seconds centred on the via point keeps position and velocity continuous:
+//   - joint coordinates on straight lines (joint mode, rest): Paul's quartic (paul_transition),
+//     which stays inside the corner it cuts, so a joint never passes its end points;
+//   - a Cartesian segment starting from or ending at rest: Paul's quartic on the drive fraction
+//     r, so the tool stays on its line;
+//   - two Cartesian segments: the blend of Lloyd and Hayward (1993), (1 - s) F1(t) + s F2(t)
+//     with s the quintic smoothstep, of both segments extended past their ends, which stays
+//     continuous when either goal moves; a joint-mode segment next to a Cartesian one: the same
+//     blend of joint vectors.
+// tau is the requested transition time / 2, lengthened so that no joint's acceleration passes
+// its bound.
+//
+// A goal that cannot be reached (out of reach, out of limits, a singularity on the way, a
+// joint that would pass its speed limit) is reported as an event: before the motion when it
+// is known then, else when it happens; the arm then stops smoothly where it is (each joint
+// decelerating at its bound, never past a limit) and the queue is cancelled.
+//
+// The generator owns the two lock-free queues between the planning level and the loop:
+// requests in, events out. Nothing in step() allocates, locks or throws.
+#pragma once
+
+#include <array>
+#include <atomic>
+#include <boost/lockfree/spsc_queue.hpp>
+#include <cstdint>
+#include <optional>
+#include <string_view>
+
+#include "rccx/kinematics/kinematics.hpp"
+#include "rccx/rccl/position.hpp"
+
+namespace rccx::rccl {
+
+enum class Mode : std::uint8_t { joint, cartesian };
+std::string_view to_string(Mode m) noexcept;
+
+/// What setmod / setvel / settime / setconf set; each request carries a copy.
+struct MotionSettings {
+  Mode mode = Mode::joint;
+  double translation_m_per_s = 0.1;    ///< tool speed along a segment (RCCL setvel, mm/s there)
+  double rotation_rad_per_s = 1.7453;  ///< tool rotation speed (100 deg/s, RCCL's default)
+  double segment_time_s = 0.0;         ///< > 0: the segment's duration instead of the speeds
+  double transition_time_s = 0.2;      ///< the transition to the next segment (2 tau)
+  /// Configuration to reach the goal in (an index of Kinematics::configuration_names()), or
+  /// -1 to keep the one the arm is in.
+  std::int16_t configuration = -1;
+};
+
+enum class RequestKind : std::uint8_t { move, dwell };
+
+/// A motion request packet (thesis figure 2.3).
+struct MotionRequest {
+  std::uint64_t id = 0;  ///< 1, 2, ... in queue order
+  RequestKind kind = RequestKind::move;
+  const Position* position = nullptr;  ///< move: kept alive by the planning level
+  MotionSettings settings;
+  double dwell_s = 0.0;  ///< dwell: how long to stay
+};
+
+enum class EventKind : std::uint8_t { started, ended, failed, cancelled };
+std::string_view to_string(EventKind k) noexcept;
+
+inline constexpr std::size_t kEventText = 120;
+
+/// What the generator tells the planning level.
+struct MotionEvent {
+  EventKind kind = EventKind::started;
+  std::uint64_t id = 0;
+  double t_s = 0.0;
+  std::uint64_t sample = 0;
+  kin::IkStatus status = kin::IkStatus::ok;  ///< failed: why, when the kinematics said so
+  int joint = 0;                             ///< failed: the 1-based joint concerned, or 0
+  std::array<char, kEventText> text{};       ///< failed: the message for people
+  [[nodiscard]] std::string_view message() const noexcept;
+};
+
+/// How well a segment followed its path (Cartesian segments; joint ones report times only).
+struct SegmentReport {
+  std::uint64_t id = 0;
+  Mode mode = Mode::joint;
+  double start_s = 0.0;     ///< when its transition in began
+  double end_s = 0.0;       ///< when its transition out ended
+  double duration_s = 0.0;  ///< the straight part's nominal length T
+  /// Outside transitions: the largest distance of the commanded and of the measured tool
+  /// point from the straight segment (m), and the largest angle between the measured and the
+  /// commanded approach vector (rad).
+  double max_commanded_path_error_m = 0.0;
+  double max_measured_path_error_m = 0.0;
+  double max_approach_error_rad = 0.0;
+  double peak_tool_speed_m_per_s = 0.0;  ///< commanded
+  /// Samples on the straight part (0: transitions took the whole segment, nothing to judge).
+  std::uint32_t straight_samples = 0;
+  bool failed = false;
+};
+
+struct GeneratorOptions {
+  double period_s = 0.01;
+  /// Per joint, rad/s or m/s: the fastest the generator commands (default: the model's top
+  /// speed). Segment times are planned at kPlanningSpeedFraction of it.
+  kin::JointVector max_velocity;
+  /// Per joint, rad/s^2 or m/s^2 (default: max_velocity / kDefaultAccelerationTime_s).
+  kin::JointVector max_acceleration;
+};
+
+/// A joint reaches its top speed from rest in this long under the default acceleration bound.
+inline constexpr double kDefaultAccelerationTime_s = 0.25;
+/// Segments are planned at this fraction of the joints' top speeds, leaving room for
+/// transitions and for the speed of a Cartesian line to vary along it.
+inline constexpr double kPlanningSpeedFraction = 0.9;
+
+class TrajectoryGenerator {
+ public:
+  static constexpr std::size_t kQueueCapacity = 256;
+  static constexpr std::size_t kReports = 256;
+
+  TrajectoryGenerator(const kin::Kinematics& kinematics, GeneratorOptions options);
+
+  // --- Planning level (one thread) ----------------------------------------------------------
+  /// Queues a request; false when the queue is full.
+  bool submit(const MotionRequest& request) noexcept;
+  /// The next event, if any.
+  std::optional<MotionEvent> next_event() noexcept;
+  /// Asks the loop to stop smoothly where it is and cancel everything queued.
+  void request_halt() noexcept { halt_requested_.store(true, std::memory_order_release); }
+  /// Highest id started / ended (ended includes failed and cancelled), in queue order.
+  [[nodiscard]] std::uint64_t started_upto() const noexcept { return started_.load(); }
+  [[nodiscard]] std::uint64_t ended_upto() const noexcept { return ended_.load(); }
+  /// The report of motion `id`, once ended_upto() >= id (and fewer than kReports later).
+  [[nodiscard]] SegmentReport report(std::uint64_t id) const noexcept;
+
+  // --- Sample loop ---------------------------------------------------------------------------
+  /// Starts at rest at q (rad / m), the arm's measured joints; queued requests stay queued.
+  void reset(const kin::JointVector& q, double t_s) noexcept;
+  /// The setpoint for time ctx.t_s into q (rad / m); `measured` (may be null) is the arm as
+  /// read this sample, for the path report. Returns the id of the motion the setpoint belongs
+  /// to (0 at rest). Allocates, locks and throws nothing itself; it passes on what a
+  /// functional transform's function throws.
+  std::uint64_t step(const SampleContext& ctx, const kin::JointVector* measured,
+                     kin::JointVector& q);
+  [[nodiscard]] bool at_rest() const noexcept;
+  [[nodiscard]] const kin::Kinematics& kinematics() const noexcept { return kin_; }
+
+ private:
+  struct Segment {
+    enum class Kind : std::uint8_t { rest, joint, cartesian };
+    Kind kind = Kind::rest;
+    bool resting = false;  ///< cartesian: r stays 1 (tracking a moving goal)
+    const Position* position = nullptr;
+    std::uint64_t id = 0;  ///< 0: not a motion (rest)
+    MotionSettings settings;
+    double ts = 0.0, T = 1.0;  ///< the straight part starts at ts (the via time) and lasts T, s
+    double tau_in = 0.0;       ///< half the transition into it, s
+    double stop_tau = 0.0;     ///< half the transition to rest at its end, s
+    kin::JointVector q0, q1;   ///< joint: from, to; rest: q1 is where it stays
+    LatchedHolds holds;
+    math::Transform fixed_goal;  ///< a position given in joints: its T6
+    math::DriveTransform drive;  ///< cartesian: from the start (in the goal's frame) to I
+    kin::Configuration configuration;
+    bool has_configuration = false;
+  };
+  /// A Cartesian segment's frames at one instant.
+  struct Pose {
+    math::Transform goal, tool, frame, t6;  ///< G, the tool product, F = G D(r), T6
+  };
+  enum class Blend : std::uint8_t { paul_joint, paul_r_in, paul_r_out, smooth_pose, smooth_joint };
+  struct Transition {
+    bool active = false;
+    bool to_next = false;  ///< false: to rest at the end of cur_
+    double tB = 0.0, tau = 0.0;
+    Blend blend = Blend::paul_joint;
+  };
+  struct Halt {
+    bool active = false;
+    double t0 = 0.0;
+    kin::JointVector q0, v0, stop_time;
+  };
+  using Text = std::array<char, kEventText>;
+
+  [[nodiscard]] double fraction(const Segment& s, double t) const noexcept;
+  [[nodiscard]] double drive_fraction(const Segment& s, double t) const noexcept {
+    return s.resting ? 1.0 : fraction(s, t);
+  }
+  void pose_at(const Segment& s, const SampleContext& ctx, double r, Pose& out) const;
+  bool solve(const Segment& s, const math::Transform& t6, const kin::JointVector& near,
+             kin::JointVector& q, kin::IkStatus& why) const noexcept;
+  bool segment_value(const Segment& s, const SampleContext& ctx, double t,
+                     const kin::JointVector& near, kin::JointVector& q, kin::IkStatus& why,
+                     Pose* pose = nullptr) const;
+  [[nodiscard]] Segment rest_of(const Segment& a) const noexcept;
+
+  bool build(const MotionRequest& r, const SampleContext& ctx, double t_via);
+  [[nodiscard]] Blend blend_between(const Segment& a, const Segment* b) const noexcept;
+  double transition_tau(const Segment& a, const Segment& b, Blend blend, double tB,
+                        const SampleContext& ctx) const;
+  void begin_transition(const SampleContext& ctx, double tB, double tau, Blend blend,
+                        bool to_next) noexcept;
+  void finish_transition(const SampleContext& ctx);
+  bool value(const SampleContext& ctx, double t, kin::JointVector& q, kin::IkStatus& why);
+
+  void emit(EventKind kind, std::uint64_t id, const SampleContext& ctx,
+            kin::IkStatus status = kin::IkStatus::ok, int joint = 0,
+            std::string_view text = {}) noexcept;
+  void end_motion(const Segment& s, const SampleContext& ctx) noexcept;
+  void fail(std::uint64_t id, const SampleContext& ctx, kin::IkStatus status, int joint,
+            const Text& text) noexcept;
+  void start_halt(const SampleContext& ctx) noexcept;
+  void halt_value(double t, kin::JointVector& q) noexcept;
+  void rest_at(const kin::JointVector& q) noexcept;
+  void record(const SampleContext& ctx, const kin::JointVector& q,
+              const kin::JointVector* measured) noexcept;
+
+  const kin::Kinematics& kin_;
+  GeneratorOptions options_;
+  kin::JointVector lower_, upper_;
+
+  boost::lockfree::spsc_queue<MotionRequest, boost::lockfree::capacity<kQueueCapacity>> requests_;
+  boost::lockfree::spsc_queue<MotionEvent, boost::lockfree::capacity<4 * kQueueCapacity>> events_;
+  std::atomic<bool> halt_requested_{false};
+  std::atomic<std::uint64_t> started_{0}, ended_{0};
+  std::array<SegmentReport, kReports> reports_{};
+
+  // Loop state.
+  Segment cur_, next_;
+  bool has_next_ = false;
+  double next_tau_ = 0.0;                 ///< half the transition from cur_ into next_, s
+  std::optional<MotionRequest> waiting_;  ///< taken from the queue, not yet built
+  Transition tr_;
+  Halt halt_;
+  kin::JointVector last_q_, prev_q_;  ///< the last two setpoints
+  double last_t_ = 0.0;
+  Pose pose_;  ///< cur_'s frames this sample, when it is a Cartesian segment outside transitions
+  bool pose_valid_ = false;
+  math::Vec3 last_frame_p_;
+  bool have_last_frame_ = false;
+};
+
+}  // namespace rccx::rccl

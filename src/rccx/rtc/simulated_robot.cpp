@@ -1,0 +1,49 @@
+#include "rccx/rtc/simulated_robot.hpp"
+
+#include "rccx/rtc/microbo_driver.hpp"
+#include "rccx/rtc/servo_driver.hpp"
+
+namespace rccx::rtc {
+
+std::chrono::nanoseconds SimulatedRobot::usual_period(const kin::RobotModel& model) {
+  using std::chrono::milliseconds;
+  return model.hardware_json.empty() ? milliseconds(10) : milliseconds(28);
+}
+
+SimulatedRobot::SimulatedRobot(kin::RobotModel m, const SimulatedRobotOptions& options)
+    : model(std::move(m)) {
+  hw::SimulatedArmOptions arm_options;
+  arm_options.calibrated = options.calibrated;
+  if (!model.hardware_json.empty()) {
+    rcu = std::make_unique<hw::Rcu>(model, arm_options);
+    bus = std::make_unique<hw::RcuBus>(*rcu);
+    MicroboDriverOptions o;
+    for (std::size_t j = 0; j < model.dof(); ++j) o.work_areas[j] = rcu->work_area(j);
+    driver = std::make_unique<MicroboDriver>(model, *bus, *rcu, o);
+  } else {
+    arm = hw::make_simulated_arm(model, arm_options);
+    driver = std::make_unique<ServoDriver>(*arm);
+  }
+  SessionOptions so;
+  so.period = options.period.count() > 0 ? options.period : usual_period(model);
+  so.clock = options.clock;
+  session = std::make_unique<Session>(*driver, so);
+  if (!options.log.empty()) {
+    log = std::make_unique<SampleLog>(options.log, model);
+    session->set_log(log.get());
+  }
+}
+
+double SimulatedRobot::period_s() const {
+  return std::chrono::duration<double>(session->period()).count();
+}
+
+void SimulatedRobot::push(std::size_t joint, double effort) {
+  if (rcu) {
+    rcu->set_external_effort(joint, effort);
+  } else {
+    arm->set_external_effort(joint, effort);
+  }
+}
+
+}  // namespace rccx::rtc

@@ -1,0 +1,50 @@
+// A simulated robot below the wire with an RTC session on it, assembled in one call: the
+// Microbo's emulated RCU behind its bus and register-level driver when the robot file describes
+// an RCU, else a servo arm (the PUMA's PID servos, or the ideal servo for any robot file). What
+// the control programs, the examples and the compat layer all start from.
+#pragma once
+
+#include <chrono>
+#include <filesystem>
+#include <memory>
+#include <stdexcept>
+
+#include "rccx/hw/rcu.hpp"
+#include "rccx/hw/simulated_arm.hpp"
+#include "rccx/rtc/driver.hpp"
+#include "rccx/rtc/sample_log.hpp"
+#include "rccx/rtc/session.hpp"
+
+namespace rccx::rtc {
+
+struct SimulatedRobotOptions {
+  /// Sample period; zero: the robot's usual one (28 ms for the Microbo, whose bus needs about
+  /// 10 ms a sample, 10 ms for the others).
+  std::chrono::nanoseconds period{0};
+  ClockKind clock = ClockKind::simulated;
+  bool calibrated = true;  ///< false: encoders relative to power-up
+  std::filesystem::path log;  ///< a CSV of every controlled sample; empty: none (or RCCX_LOG)
+};
+
+struct SimulatedRobot {
+  /// Throws std::invalid_argument when the robot cannot be simulated, SessionError for a bad
+  /// period, LogError for a log file that cannot be written.
+  SimulatedRobot(kin::RobotModel model, const SimulatedRobotOptions& options = {});
+
+  kin::RobotModel model;
+  std::unique_ptr<hw::SimulatedArm> arm;  ///< servo arms
+  std::unique_ptr<hw::Rcu> rcu;           ///< the Microbo
+  std::unique_ptr<hw::RcuBus> bus;
+  std::unique_ptr<Driver> driver;
+  std::unique_ptr<SampleLog> log;
+  std::unique_ptr<Session> session;
+
+  /// The usual sample period of a robot.
+  static std::chrono::nanoseconds usual_period(const kin::RobotModel& model);
+  [[nodiscard]] bool simulated() const { return session->clock() == ClockKind::simulated; }
+  [[nodiscard]] double period_s() const;
+  /// A simulated hand pushes a joint (N m or N); only between samples of simulated time.
+  void push(std::size_t joint, double effort);
+};
+
+}  // namespace rccx::rtc
