@@ -63,8 +63,9 @@ int main() {
   arm.waitfor(motions.back().end());
   const rtc::Termination t = arm.stop_control();
 
-  fmt::print("\n seg  mode       start s   end s   T s   path error mm (cmd / measured)  "
-             "approach deg  top speed mm/s\n");
+  fmt::print(
+      "\n seg  mode       start s   end s   T s   path error mm (cmd / measured)  "
+      "approach deg  top speed mm/s\n");
   std::vector<double> round_error(3, 0.0);
   for (std::size_t i = 0; i < motions.size(); ++i) {
     const rccl::SegmentReport r = arm.report(motions[i]);

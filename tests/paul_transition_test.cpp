@@ -68,7 +68,8 @@ TEST(PaulTransition, PeakAccelerationIsInTheMiddleAndTheTransitionTimeBoundsIt) 
     double largest = 0;
     for (int i = 0; i <= 2000; ++i) {
       const double t = -c.tau + 2 * c.tau * i / 2000.0;
-      largest = std::max(largest, std::abs(paul_transition(c.B, c.dB(), c.dC(), c.tau, c.T, t).qdd));
+      largest =
+          std::max(largest, std::abs(paul_transition(c.B, c.dB(), c.dC(), c.tau, c.T, t).qdd));
     }
     const double peak = paul_transition_peak_acceleration(c.dB(), c.dC(), c.tau, c.T);
     EXPECT_NEAR(largest, peak, 1e-9 * (1 + peak));

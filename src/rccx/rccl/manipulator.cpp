@@ -9,10 +9,14 @@ namespace rccx::rccl {
 
 std::string_view to_string(WaitResult r) noexcept {
   switch (r) {
-    case WaitResult::reached: return "reached";
-    case WaitResult::failed: return "failed";
-    case WaitResult::timeout: return "timeout";
-    case WaitResult::session_ended: return "session ended";
+    case WaitResult::reached:
+      return "reached";
+    case WaitResult::failed:
+      return "failed";
+    case WaitResult::timeout:
+      return "timeout";
+    case WaitResult::session_ended:
+      return "session ended";
   }
   return "?";
 }
@@ -85,8 +89,8 @@ void Manipulator::set_velocity(double translation_m_per_s, double rotation_rad_p
 
 void Manipulator::set_segment_time(double seconds) {
   if (!(seconds >= 0.0) || !std::isfinite(seconds)) {
-    throw MotionError(fmt::format("segment time must be >= 0 s (0: from the speeds), got {}",
-                                  seconds));
+    throw MotionError(
+        fmt::format("segment time must be >= 0 s (0: from the speeds), got {}", seconds));
   }
   settings_.segment_time_s = seconds;
 }
@@ -111,8 +115,7 @@ void Manipulator::set_configuration(std::string_view name) {
       known += n;
     }
     throw MotionError(fmt::format("robot {} has no configuration '{}' (it has: {})",
-                                  kinematics_->model().name, name,
-                                  known.empty() ? "none" : known));
+                                  kinematics_->model().name, name, known.empty() ? "none" : known));
   }
   settings_.configuration = c->index;
 }
@@ -128,10 +131,10 @@ void Manipulator::check_reachable(const Position& p) const {
     const int out = kinematics_->model().first_joint_outside_limits(q, kin::kLimitTolerance);
     if (out >= 0) {
       const kin::Joint& j = kinematics_->model().joints[static_cast<std::size_t>(out)];
-      throw MotionError(fmt::format("position {}: joint {} ({}) = {:.6g} is outside its limits "
-                                    "[{:.6g}, {:.6g}]",
-                                    p.name(), out + 1, j.name, q[static_cast<std::size_t>(out)],
-                                    j.lower, j.upper));
+      throw MotionError(fmt::format(
+          "position {}: joint {} ({}) = {:.6g} is outside its limits "
+          "[{:.6g}, {:.6g}]",
+          p.name(), out + 1, j.name, q[static_cast<std::size_t>(out)], j.lower, j.upper));
     }
     return;
   }
@@ -188,11 +191,14 @@ void Manipulator::halt() {
 
 bool Manipulator::happened(const Event& e) const noexcept {
   switch (e.kind) {
-    case Event::Kind::motion_start: return generator_->started_upto() >= e.id;
-    case Event::Kind::motion_end: return generator_->ended_upto() >= e.id;
+    case Event::Kind::motion_start:
+      return generator_->started_upto() >= e.id;
+    case Event::Kind::motion_end:
+      return generator_->ended_upto() >= e.id;
     case Event::Kind::position_end:
       return e.position->pending_ends.load(std::memory_order_acquire) <= 0;
-    case Event::Kind::completed: return generator_->ended_upto() >= next_id_ - 1;
+    case Event::Kind::completed:
+      return generator_->ended_upto() >= next_id_ - 1;
   }
   return false;
 }

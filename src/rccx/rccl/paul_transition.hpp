@@ -31,8 +31,7 @@ constexpr TransitionPoint paul_transition(double B, double dB, double dC, double
   const double h = (t + tau) / (2.0 * tau);
   const double k = dC * tau / T + dB;
   return {((k * (2.0 - h) * h * h) - 2.0 * dB) * h + B + dB,
-          (k * (1.5 - h) * 2.0 * h * h - dB) / tau,
-          k * (1.0 - h) * 3.0 * h / (tau * tau)};
+          (k * (1.5 - h) * 2.0 * h * h - dB) / tau, k * (1.0 - h) * 3.0 * h / (tau * tau)};
 }
 
 /// The largest |acceleration| of that transition, unit/s^2 (at t = 0).

@@ -40,8 +40,8 @@ void Position::append(Factors& to, const TransformPtr& t, bool inverted, std::ui
 PositionPtr Position::make(std::string name, const std::vector<TransformPtr>& lhs,
                            const std::vector<TransformPtr>& rhs, const TransformPtr& tool) {
   const auto fail = [&](std::string_view why) {
-    return EquationError(fmt::format("position {} ({} = {}): {}", name, names(lhs), names(rhs),
-                                     why));
+    return EquationError(
+        fmt::format("position {} ({} = {}): {}", name, names(lhs), names(rhs), why));
   };
   const auto is_t6 = [](const TransformPtr& t) { return t && t->kind() == TransformKind::t6; };
   for (const auto* side : {&lhs, &rhs}) {
@@ -67,14 +67,15 @@ PositionPtr Position::make(std::string name, const std::vector<TransformPtr>& lh
       seen.push_back(t.get());
     }
   }
-  const auto t6_at = static_cast<std::size_t>(std::find_if(lhs.begin(), lhs.end(), is_t6) -
-                                              lhs.begin());
+  const auto t6_at =
+      static_cast<std::size_t>(std::find_if(lhs.begin(), lhs.end(), is_t6) - lhs.begin());
   if (!tool) throw fail("no tool transform given (name T6 itself when there is no tool)");
   const auto tool_it = std::find(lhs.begin() + static_cast<std::ptrdiff_t>(t6_at), lhs.end(), tool);
   if (tool_it == lhs.end()) {
-    throw fail(fmt::format("the tool {} is not on the left side after T6; the tool is one of "
-                           "the transforms between T6 and the equals sign (or T6 itself)",
-                           tool->name()));
+    throw fail(
+        fmt::format("the tool {} is not on the left side after T6; the tool is one of "
+                    "the transforms between T6 and the equals sign (or T6 itself)",
+                    tool->name()));
   }
   const auto tool_at = static_cast<std::size_t>(tool_it - lhs.begin());
   std::size_t holds = 0;
@@ -135,10 +136,17 @@ math::Transform Position::product(const Factors& fs, const SampleContext& ctx,
   for (const Factor& f : fs) {
     math::Transform v;
     switch (f.kind) {
-      case TransformKind::constant: v = f.value; break;
-      case TransformKind::functional: v = f.source->evaluate(ctx); break;
-      case TransformKind::hold: v = holds.values[f.hold_slot]; break;
-      case TransformKind::t6: continue;
+      case TransformKind::constant:
+        v = f.value;
+        break;
+      case TransformKind::functional:
+        v = f.source->evaluate(ctx);
+        break;
+      case TransformKind::hold:
+        v = holds.values[f.hold_slot];
+        break;
+      case TransformKind::t6:
+        continue;
     }
     if (f.inverted && f.kind != TransformKind::constant) v = v.inverse();
     r = first ? v : r * v;
@@ -151,8 +159,8 @@ void Position::latch(LatchedHolds& holds) const noexcept {
   for (std::uint8_t i = 0; i < hold_count_; ++i) holds.values[i] = holds_[i]->latch();
 }
 
-void Position::evaluate(const SampleContext& ctx, const LatchedHolds& holds,
-                        math::Transform& goal, math::Transform& tool) const {
+void Position::evaluate(const SampleContext& ctx, const LatchedHolds& holds, math::Transform& goal,
+                        math::Transform& tool) const {
   goal = product(goal_, ctx, holds);
   tool = product(tool_, ctx, holds);
 }

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "rccx/rccl/paul_transition.hpp"
 
@@ -24,11 +25,15 @@ constexpr double smoothstep(double u) noexcept {
 /// u = 1/2, and d/dt = d/du / 2 tau).
 constexpr double kPaulPeak = 0.75;
 constexpr double kSmoothPeak = 1.875;
+/// The sample loop stops the arm rather than command a joint acceleration above this multiple
+/// of its bound: planned motions stay within the bound; only a singularity or a jump passes it.
+constexpr double kAccelerationGuard = 2.0;
+/// A segment is slowed at most this much to fit the transition into it.
+constexpr double kMaxStretch = 8.0;
 
 /// The pose a fraction s of the way from a to b: position on the line, rotation about the
 /// fixed axis of a⁻¹ b.
-math::Transform interpolate(const math::Transform& a, const math::Transform& b,
-                            double s) noexcept {
+math::Transform interpolate(const math::Transform& a, const math::Transform& b, double s) noexcept {
   const math::Rot3 rel = a.R.transposed() * b.R;
   math::Vec3 axis;
   double angle = 0.0;
@@ -72,10 +77,14 @@ std::string_view to_string(Mode m) noexcept {
 
 std::string_view to_string(EventKind k) noexcept {
   switch (k) {
-    case EventKind::started: return "started";
-    case EventKind::ended: return "ended";
-    case EventKind::failed: return "failed";
-    case EventKind::cancelled: return "cancelled";
+    case EventKind::started:
+      return "started";
+    case EventKind::ended:
+      return "ended";
+    case EventKind::failed:
+      return "failed";
+    case EventKind::cancelled:
+      return "cancelled";
   }
   return "?";
 }
@@ -156,10 +165,12 @@ bool TrajectoryGenerator::solve(const Segment& s, const math::Transform& t6,
 }
 
 bool TrajectoryGenerator::segment_value(const Segment& s, const SampleContext& ctx, double t,
-                                        const JointVector& near, JointVector& q,
-                                        kin::IkStatus& why, Pose* pose) const {
+                                        const JointVector& near, JointVector& q, kin::IkStatus& why,
+                                        Pose* pose) const {
   switch (s.kind) {
-    case Segment::Kind::rest: q = s.q1; return true;
+    case Segment::Kind::rest:
+      q = s.q1;
+      return true;
     case Segment::Kind::joint: {
       const double r = fraction(s, t);
       q = s.q0;
@@ -176,7 +187,8 @@ bool TrajectoryGenerator::segment_value(const Segment& s, const SampleContext& c
   return false;
 }
 
-// --- Building segments -----------------------------------------------------------------------------
+// --- Building segments
+// -----------------------------------------------------------------------------
 
 bool TrajectoryGenerator::build(const MotionRequest& r, const SampleContext& ctx, double t_via) {
   const std::size_t n = kin_.dof();
@@ -247,14 +259,17 @@ bool TrajectoryGenerator::build(const MotionRequest& r, const SampleContext& ctx
       std::max(offset.p.norm() / std::max(s.settings.translation_m_per_s, 1e-9),
                rotation_angle(offset.R) / std::max(s.settings.rotation_rad_per_s, 1e-9));
   double by_joints = 0.0;  // the time the joints' top speeds allow, s
+  JointVector end_step;    // cartesian: the joints' change over the line's last part, per unit r
   double by_acceleration = 0.0;
   const auto joint_time = [&](const JointVector& a, const JointVector& b, double scale) {
     for (std::size_t j = 0; j < n; ++j) {
       const double d = std::abs(b[j] - a[j]) * scale;
       by_joints = std::max(by_joints, d / (kPlanningSpeedFraction * options_.max_velocity[j]));
-      // Room for the transitions in and out at the acceleration bound: each needs up to
-      // tau = 0.75 dv / a with dv up to 2 v, v = d / T, and together they must fit in T.
-      by_acceleration = std::max(by_acceleration, std::sqrt(3.0 * d / options_.max_acceleration[j]));
+      // Room for the transitions in and out at the acceleration bound: the part of each that
+      // this segment's own velocity v = d / T causes, tau = 1.875 v / a (the smooth blend),
+      // takes at most a quarter of T, leaving the rest for its neighbours' velocities.
+      by_acceleration =
+          std::max(by_acceleration, std::sqrt(4.0 * kSmoothPeak * d / planning_acceleration(j)));
     }
   };
 
@@ -263,8 +278,8 @@ bool TrajectoryGenerator::build(const MotionRequest& r, const SampleContext& ctx
     if (pos.in_joints()) {
       s.q1 = pos.joint_values();
     } else if (!solve(s, goal.t6, qB, s.q1, why)) {
-      fail(r.id, ctx, why, 0, text("position {} cannot be reached in joint mode: {}", name,
-                                          kin::describe(why)));
+      fail(r.id, ctx, why, 0,
+           text("position {} cannot be reached in joint mode: {}", name, kin::describe(why)));
       return false;
     }
     joint_time(s.q0, s.q1, 1.0);
@@ -275,29 +290,45 @@ bool TrajectoryGenerator::build(const MotionRequest& r, const SampleContext& ctx
     // need more than its speed, is reported now rather than in the middle of the motion.
     constexpr int kChecks = 16;
     JointVector q_prev = qB, q;
+    end_step = JointVector(n);
     for (int k = 1; k <= kChecks; ++k) {
       Pose p;
       pose_at(s, ctx, static_cast<double>(k) / kChecks, p);
       if (!solve(s, p.t6, q_prev, q, why)) {
         fail(r.id, ctx, why, 0,
-             text("the straight line to {} leaves the workspace {:.0f}% of the way: {}",
-                         name, 100.0 * k / kChecks, kin::describe(why)));
+             text("the straight line to {} leaves the workspace {:.0f}% of the way: {}", name,
+                  100.0 * k / kChecks, kin::describe(why)));
         return false;
       }
       joint_time(q_prev, q, kChecks);
+      for (std::size_t j = 0; j < n; ++j) end_step[j] = (q[j] - q_prev[j]) * kChecks;
       q_prev = q;
     }
     s.q1 = q;
   }
   s.T = s.settings.segment_time_s > 0.0 ? s.settings.segment_time_s : by_speed;
-  s.T = std::max({s.T, by_joints, by_acceleration, s.settings.transition_time_s,
-                  2.0 * options_.period_s});
+  s.T = std::max(
+      {s.T, by_joints, by_acceleration, s.settings.transition_time_s, 2.0 * options_.period_s});
   s.stop_tau = std::max(options_.period_s, 0.5 * s.settings.transition_time_s);
   for (std::size_t j = 0; j < n; ++j) {
-    const double v = std::abs(s.q1[j] - s.q0[j]) / s.T;
-    s.stop_tau = std::max(s.stop_tau, kPaulPeak * v / options_.max_acceleration[j]);
+    // The velocity at the end, where the arm stops: a Cartesian line's is not its average.
+    double v = std::abs(s.q1[j] - s.q0[j]) / s.T;
+    if (end_step.size() == n) v = std::max(v, std::abs(end_step[j]) / s.T);
+    s.stop_tau = std::max(s.stop_tau, kPaulPeak * v / planning_acceleration(j));
   }
   s.stop_tau = std::min(s.stop_tau, 0.5 * s.T);
+  // As for transitions between segments (transition_tau): check the stop as the loop will run
+  // it, and lengthen it (and the segment, if need be) while a joint would pass its bound.
+  const double planned_T = s.T;
+  for (int pass = 0; pass < 3; ++pass) {
+    const double worst = blend_acceleration_ratio(s, s, false, blend_between(s, nullptr),
+                                                  s.ts + s.T, s.stop_tau, s.q1, ctx);
+    if (!(worst > 1.0)) break;
+    // A transition's acceleration falls as 1 / tau; a far larger ratio means a singularity on
+    // the way, which lengthening does not cure (the loop will stop the arm there).
+    s.stop_tau = std::min(s.stop_tau * std::min(worst * 1.05, 2.0), kMaxStretch * planned_T / 2.0);
+    s.T = std::max(s.T, 2.0 * s.stop_tau);
+  }
   next_ = s;
   has_next_ = true;
   return true;
@@ -316,29 +347,108 @@ TrajectoryGenerator::Blend TrajectoryGenerator::blend_between(const Segment& a,
   return Blend::smooth_joint;
 }
 
-double TrajectoryGenerator::transition_tau(const Segment& a, const Segment& b, Blend blend,
-                                           double tB, const SampleContext& ctx) const {
+double TrajectoryGenerator::transition_tau(const Segment& a, Segment& b, Blend blend, double tB,
+                                           const SampleContext& ctx) const {
   const double P = options_.period_s;
+  const std::size_t n = kin_.dof();
   const Segment& owner = a.kind == Segment::Kind::rest ? b : a;
   double tau = std::max(P, 0.5 * owner.settings.transition_time_s);
-  // The change of joint velocity across the via point, from values one period apart.
+  // The joint velocities either side of the via point, from values one period apart.
   JointVector qa0, qa1, qb0, qb1;
   kin::IkStatus why;
   if (!segment_value(a, ctx, tB - P, last_q_, qa0, why) ||
-      !segment_value(a, ctx, tB, last_q_, qa1, why) ||
-      !segment_value(b, ctx, tB, qa1, qb0, why) || !segment_value(b, ctx, tB + P, qb0, qb1, why)) {
+      !segment_value(a, ctx, tB, last_q_, qa1, why) || !segment_value(b, ctx, tB, qa1, qb0, why) ||
+      !segment_value(b, ctx, tB + P, qb0, qb1, why)) {
     return tau;
   }
-  const double peak = blend == Blend::smooth_pose || blend == Blend::smooth_joint ? kSmoothPeak
-                                                                                   : kPaulPeak;
-  for (std::size_t j = 0; j < kin_.dof(); ++j) {
-    const double dv = ((qb1[j] - qb0[j]) - (qa1[j] - qa0[j])) / P;
-    tau = std::max(tau, peak * std::abs(dv) / options_.max_acceleration[j]);
+  JointVector va(n), vb(n);
+  for (std::size_t j = 0; j < n; ++j) {
+    va[j] = (qa1[j] - qa0[j]) / P;
+    vb[j] = (qb1[j] - qb0[j]) / P;
   }
-  // The transition may not reach back past the start of a's straight part nor beyond b's.
-  if (a.kind != Segment::Kind::rest) tau = std::min(tau, std::max(P, tB - (a.ts + a.tau_in)));
+  const double peak =
+      blend == Blend::smooth_pose || blend == Blend::smooth_joint ? kSmoothPeak : kPaulPeak;
+  const auto needed = [&] {
+    double t = 0.0;
+    for (std::size_t j = 0; j < n; ++j) {
+      t = std::max(t, peak * std::abs(vb[j] - va[j]) / planning_acceleration(j));
+    }
+    return t;
+  };
+  // The transition may not reach back past the start of a's straight part: when the change of
+  // velocity needs longer than a has left, b (not started yet) is slowed down until it fits -
+  // its velocity scales as 1 / T.
+  const double room = a.kind == Segment::Kind::rest ? std::numeric_limits<double>::infinity()
+                                                    : std::max(P, tB - (a.ts + a.tau_in));
+  double stretched = 1.0;  // b.T grows by at most kMaxStretch in all
+  if (b.kind != Segment::Kind::rest && std::isfinite(room)) {
+    double stretch = 1.0;
+    for (std::size_t j = 0; j < n; ++j) {
+      const double w = planning_acceleration(j) * room / peak;  // the |dv| a's room allows
+      if (std::abs(vb[j] - va[j]) <= w) continue;
+      const double side = w + (vb[j] > 0.0 ? va[j] : -va[j]);  // b's bound on its side of 0
+      if (side > 0.0) stretch = std::max(stretch, std::abs(vb[j]) / side);
+    }
+    stretch = std::min(stretch, kMaxStretch);
+    b.T *= stretch;
+    stretched *= stretch;
+    for (std::size_t j = 0; j < n; ++j) vb[j] /= stretch;
+  }
+  tau = std::max(tau, needed());
+  // Nor beyond half of b: b is lengthened instead (twice, as slowing b changes the need).
+  for (int i = 0; i < 2 && b.kind != Segment::Kind::rest && tau > 0.5 * b.T; ++i) {
+    const double stretch = std::min(2.0 * tau / b.T, kMaxStretch / stretched);
+    if (!(stretch > 1.0)) break;
+    b.T *= stretch;
+    stretched *= stretch;
+    for (std::size_t j = 0; j < n; ++j) vb[j] /= stretch;
+    tau = std::max(std::max(P, 0.5 * owner.settings.transition_time_s), needed());
+  }
   if (b.kind != Segment::Kind::rest) tau = std::min(tau, std::max(P, 0.5 * b.T));
+  tau = std::min(tau, room);
+  if (a.kind == Segment::Kind::rest) return tau;
+  // The estimate above is for straight lines in joint space; a Cartesian blend bends them.
+  // Sample the transition as the loop will and lengthen it while a joint would accelerate
+  // past its bound.
+  for (int pass = 0; pass < 3; ++pass) {
+    const double worst = blend_acceleration_ratio(a, b, true, blend, tB, tau, last_q_, ctx);
+    if (!(worst > 1.0) || tau >= room) break;
+    tau = std::min(room, tau * std::min(worst * 1.05, 2.0));
+    if (tau > 0.5 * b.T) {
+      const double stretch = std::min(2.0 * tau / b.T, kMaxStretch / stretched);
+      if (stretch > 1.0) {
+        b.T *= stretch;
+        stretched *= stretch;
+      }
+      tau = std::min(tau, 0.5 * b.T);
+    }
+  }
   return tau;
+}
+
+double TrajectoryGenerator::blend_acceleration_ratio(const Segment& a, const Segment& b,
+                                                     bool to_next, Blend blend, double tB,
+                                                     double tau, const JointVector& near,
+                                                     const SampleContext& ctx) const {
+  const double P = options_.period_s;
+  JointVector q0, q1, q2;
+  kin::IkStatus why;
+  double worst = 0.0;
+  const auto at = [&](double t, const JointVector& seed, JointVector& q) {
+    return blend_value(a, b, to_next, blend, tB, tau, ctx, t, seed, q, why);
+  };
+  double t = tB - tau;
+  if (!at(t - P, near, q0) || !at(t, q0, q1)) return 0.0;
+  for (; t <= tB + tau; t += P) {
+    if (!at(t + P, q1, q2)) return 0.0;  // the loop will report it
+    for (std::size_t j = 0; j < q1.size(); ++j) {
+      const double acc = std::abs(q2[j] - 2.0 * q1[j] + q0[j]) / (P * P);
+      worst = std::max(worst, acc / options_.max_acceleration[j]);
+    }
+    q0 = q1;
+    q1 = q2;
+  }
+  return worst;
 }
 
 void TrajectoryGenerator::begin_transition(const SampleContext& ctx, double tB, double tau,
@@ -398,17 +508,22 @@ bool TrajectoryGenerator::value(const SampleContext& ctx, double t, JointVector&
     }
     return ok;
   }
-  const Segment& a = cur_;
-  const Segment& b = tr_.to_next ? next_ : cur_;
-  const double tB = tr_.tB, tau = tr_.tau;
-  switch (tr_.blend) {
+  return blend_value(cur_, tr_.to_next ? next_ : cur_, tr_.to_next, tr_.blend, tr_.tB, tr_.tau, ctx,
+                     t, last_q_, q, why);
+}
+
+bool TrajectoryGenerator::blend_value(const Segment& a, const Segment& b, bool to_next, Blend blend,
+                                      double tB, double tau, const SampleContext& ctx, double t,
+                                      const JointVector& near, JointVector& q,
+                                      kin::IkStatus& why) const {
+  switch (blend) {
     case Blend::paul_joint: {
       // Per coordinate, from a's line onto b's (or to rest at the via point).
       JointVector qa, qB, qc;
       const Segment stop = rest_of(a);
-      const Segment& to = tr_.to_next ? b : stop;
-      if (!segment_value(a, ctx, tB - tau, last_q_, qa, why) ||
-          !segment_value(a, ctx, tB, last_q_, qB, why) ||
+      const Segment& to = to_next ? b : stop;
+      if (!segment_value(a, ctx, tB - tau, near, qa, why) ||
+          !segment_value(a, ctx, tB, near, qB, why) ||
           !segment_value(to, ctx, tB + tau, qB, qc, why)) {
         return false;
       }
@@ -422,25 +537,24 @@ bool TrajectoryGenerator::value(const SampleContext& ctx, double t, JointVector&
       const double r = paul_transition(0.0, 0.0, tau / b.T, tau, tau, t - tB).q;
       Pose p;
       pose_at(b, ctx, r, p);
-      return solve(b, p.t6, last_q_, q, why);
+      return solve(b, p.t6, near, q, why);
     }
     case Blend::paul_r_out: {
       const double r = paul_transition(1.0, -tau / a.T, 0.0, tau, tau, t - tB).q;
       Pose p;
       pose_at(a, ctx, r, p);
-      return solve(a, p.t6, last_q_, q, why);
+      return solve(a, p.t6, near, q, why);
     }
     case Blend::smooth_pose: {
       Pose pa, pb;
       pose_at(a, ctx, drive_fraction(a, t), pa);
       pose_at(b, ctx, drive_fraction(b, t), pb);
       const double s = smoothstep((t - (tB - tau)) / (2.0 * tau));
-      return solve(s < 0.5 ? a : b, interpolate(pa.t6, pb.t6, s), last_q_, q, why);
+      return solve(s < 0.5 ? a : b, interpolate(pa.t6, pb.t6, s), near, q, why);
     }
     case Blend::smooth_joint: {
       JointVector qa, qb;
-      if (!segment_value(a, ctx, t, last_q_, qa, why) ||
-          !segment_value(b, ctx, t, last_q_, qb, why)) {
+      if (!segment_value(a, ctx, t, near, qa, why) || !segment_value(b, ctx, t, near, qb, why)) {
         return false;
       }
       const double s = smoothstep((t - (tB - tau)) / (2.0 * tau));
@@ -642,20 +756,32 @@ std::uint64_t TrajectoryGenerator::step(const SampleContext& ctx, const JointVec
          text("the path cannot be followed at t = {:.3f} s: {}", t, kin::describe(why)));
     halt_value(t, q);
   } else {
-    // Never out of limits, never faster than a joint may go: stop instead.
+    // Never out of limits, never faster than a joint may go, never a jump of velocity (a path
+    // through a singularity, an IK solution changing branch, a goal that leapt): stop instead.
     for (std::size_t j = 0; j < q.size(); ++j) {
       const double speed = std::abs(q[j] - last_q_[j]) / P;
-      const bool out = !(q[j] >= lower_[j] - kin::kLimitTolerance &&
-                         q[j] <= upper_[j] + kin::kLimitTolerance);
+      const double accel = std::abs((q[j] - last_q_[j]) - (last_q_[j] - prev_q_[j])) / (P * P);
+      const bool out =
+          !(q[j] >= lower_[j] - kin::kLimitTolerance && q[j] <= upper_[j] + kin::kLimitTolerance);
       const bool fast = !(speed <= options_.max_velocity[j] * (1.0 + 1e-6));
-      if (out || fast) {
+      const bool jerky = !(accel <= kAccelerationGuard * options_.max_acceleration[j]);
+      if (out || fast || jerky) {
         const std::uint64_t id = tr_.active && tr_.to_next ? next_.id : cur_.id;
-        fail(id, ctx, out ? kin::IkStatus::joint_limits : kin::IkStatus::singular,
-             static_cast<int>(j) + 1,
-             out ? text("joint {} would leave its limits at t = {:.3f} s", j + 1, t)
-                 : text("joint {} would move at {:.3f}/s, above its top speed {:.3f}/s "
-                               "(near a singularity?)",
-                               j + 1, speed, options_.max_velocity[j]));
+        const int joint = static_cast<int>(j) + 1;
+        if (out) {
+          fail(id, ctx, kin::IkStatus::joint_limits, joint,
+               text("joint {} would leave its limits at t = {:.3f} s", joint, t));
+        } else if (fast) {
+          fail(id, ctx, kin::IkStatus::singular, joint,
+               text("joint {} would move at {:.3f}/s, above its top speed {:.3f}/s at t = {:.3f} "
+                    "s (the path passes near a singularity?)",
+                    joint, speed, options_.max_velocity[j], t));
+        } else {
+          fail(id, ctx, kin::IkStatus::singular, joint,
+               text("joint {} would accelerate at {:.1f}/s^2, {:.1f} times its bound, at t = "
+                    "{:.3f} s (the path passes near a singularity, or its goal jumped)",
+                    joint, accel, accel / options_.max_acceleration[j], t));
+        }
         halt_value(t, q);
         break;
       }

@@ -70,7 +70,7 @@ struct MotionRequest {
 enum class EventKind : std::uint8_t { started, ended, failed, cancelled };
 std::string_view to_string(EventKind k) noexcept;
 
-inline constexpr std::size_t kEventText = 120;
+inline constexpr std::size_t kEventText = 240;
 
 /// What the generator tells the planning level.
 struct MotionEvent {
@@ -117,6 +117,10 @@ inline constexpr double kDefaultAccelerationTime_s = 0.25;
 /// Segments are planned at this fraction of the joints' top speeds, leaving room for
 /// transitions and for the speed of a Cartesian line to vary along it.
 inline constexpr double kPlanningSpeedFraction = 0.9;
+/// Transitions and segment times are planned at this fraction of the acceleration bound: a
+/// Cartesian blend's joint accelerations depend on the kinematics and may exceed the linear
+/// estimate they are planned from by some percent.
+inline constexpr double kPlanningAccelerationFraction = 0.8;
 
 class TrajectoryGenerator {
  public:
@@ -187,6 +191,10 @@ class TrajectoryGenerator {
   using Text = std::array<char, kEventText>;
 
   [[nodiscard]] double fraction(const Segment& s, double t) const noexcept;
+  /// The acceleration transitions are planned at (rad/s^2 or m/s^2).
+  [[nodiscard]] double planning_acceleration(std::size_t j) const noexcept {
+    return kPlanningAccelerationFraction * options_.max_acceleration[j];
+  }
   [[nodiscard]] double drive_fraction(const Segment& s, double t) const noexcept {
     return s.resting ? 1.0 : fraction(s, t);
   }
@@ -200,8 +208,20 @@ class TrajectoryGenerator {
 
   bool build(const MotionRequest& r, const SampleContext& ctx, double t_via);
   [[nodiscard]] Blend blend_between(const Segment& a, const Segment* b) const noexcept;
-  double transition_tau(const Segment& a, const Segment& b, Blend blend, double tB,
+  /// Half the transition from a into b at via time tB, from the change of joint velocity and
+  /// the acceleration bound; lengthens b (not started yet) when a has too little room left.
+  double transition_tau(const Segment& a, Segment& b, Blend blend, double tB,
                         const SampleContext& ctx) const;
+  /// The largest joint acceleration of the transition from a into b, sampled every period,
+  /// as a multiple of the joint's bound.
+  /// `near`: joint values close to the transition's start, to seed the inverse kinematics.
+  double blend_acceleration_ratio(const Segment& a, const Segment& b, bool to_next, Blend blend,
+                                  double tB, double tau, const kin::JointVector& near,
+                                  const SampleContext& ctx) const;
+  /// The transition's setpoint at time t (its window: tB - tau .. tB + tau).
+  bool blend_value(const Segment& a, const Segment& b, bool to_next, Blend blend, double tB,
+                   double tau, const SampleContext& ctx, double t, const kin::JointVector& near,
+                   kin::JointVector& q, kin::IkStatus& why) const;
   void begin_transition(const SampleContext& ctx, double tB, double tau, Blend blend,
                         bool to_next) noexcept;
   void finish_transition(const SampleContext& ctx);

@@ -21,10 +21,14 @@ void check_rigid(const std::string& name, const math::Transform& value) {
 
 std::string_view to_string(TransformKind kind) noexcept {
   switch (kind) {
-    case TransformKind::constant: return "constant";
-    case TransformKind::functional: return "functional";
-    case TransformKind::hold: return "hold";
-    case TransformKind::t6: return "T6";
+    case TransformKind::constant:
+      return "constant";
+    case TransformKind::functional:
+      return "functional";
+    case TransformKind::hold:
+      return "hold";
+    case TransformKind::t6:
+      return "T6";
   }
   return "?";
 }
@@ -39,10 +43,10 @@ Transform::Transform(std::string name, TransformKind kind, const math::Transform
 
 void Transform::set(const math::Transform& value) {
   if (kind_ != TransformKind::hold) {
-    throw std::logic_error(fmt::format(
-        "transform {} is {}: only hold transforms can be set after they are made "
-        "(make it with rccl::hold)",
-        name_, to_string(kind_)));
+    throw std::logic_error(
+        fmt::format("transform {} is {}: only hold transforms can be set after they are made "
+                    "(make it with rccl::hold)",
+                    name_, to_string(kind_)));
   }
   check_rigid(name_, value);
   planning_value_ = value;

@@ -22,7 +22,7 @@ struct SimulatedRobotOptions {
   /// 10 ms a sample, 10 ms for the others).
   std::chrono::nanoseconds period{0};
   ClockKind clock = ClockKind::simulated;
-  bool calibrated = true;  ///< false: encoders relative to power-up
+  bool calibrated = true;     ///< false: encoders relative to power-up
   std::filesystem::path log;  ///< a CSV of every controlled sample; empty: none (or RCCX_LOG)
 };
 

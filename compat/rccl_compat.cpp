@@ -1,0 +1,596 @@
+// RCCL's 1986 C interface (compat/rccl.h, compat/rtc.h) over rccx::rccl: the thesis's calls
+// with its units (mm, deg, ms) on a simulated robot (rtc::SimulatedRobot) and one
+// rccl::Manipulator. No exception leaves this file: every entry point catches, sets rtc_error,
+// keeps the message and returns an error code (or NULL).
+//
+// The C side sees plain values that this file keeps up to date: POS.end (no motion to the
+// position pending, from Position::pending_ends) and `completed` (every queued motion ended),
+// refreshed by every call and after every sample waitfor() lets run.
+#include <fmt/format.h>
+
+#include <array>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdarg>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <map>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "rccx/kinematics/robot_model.hpp"
+#include "rccx/math/transform.hpp"
+#include "rccx/math/units.hpp"
+#include "rccx/rccl/manipulator.hpp"
+#include "rccx/rccl/position.hpp"
+#include "rccx/rccl/transforms.hpp"
+#include "rccx/rtc/sample_log.hpp"
+#include "rccx/rtc/session.hpp"
+#include "rccx/rtc/simulated_robot.hpp"
+
+// The C headers last, so that their macros (EQ, TL, waitfor) never reach rccx's headers. Their
+// global names (move, park, t6, completed) are why this file always writes std::move.
+#include "rccl.h"
+#include "rtc.h"
+
+/// What a TRSF_PTR points to: a shared rccx transform (null for the EQ and TL marks).
+struct rccl_trsf {
+  rccx::rccl::TransformPtr transform;
+};
+
+namespace {
+
+namespace math = rccx::math;
+namespace kin = rccx::kin;
+namespace rtc = rccx::rtc;
+namespace rc = rccx::rccl;
+
+/// A position the C program holds: the POS it sees and the equation behind it.
+struct PositionBox {
+  POS c{1, nullptr};
+  std::string name;
+  rc::PositionPtr position;
+};
+
+/// Everything the C calls share. Members are destroyed in reverse order: the manipulator
+/// before the robot whose session it uses, both before the positions and transforms.
+struct State {
+  std::map<const rccl_trsf*, std::unique_ptr<rccl_trsf>> transforms;
+  std::map<const POS*, std::unique_ptr<PositionBox>> positions;
+  rc::MotionSettings settings;  ///< setvel, setmod, settime: applied at each move()
+  std::unique_ptr<rtc::SimulatedRobot> robot;
+  std::unique_ptr<rc::Manipulator> arm;
+  bool controlling = false;  ///< rccl_control() was called in this session
+  bool told_ended = false;   ///< the end of control was printed
+  std::size_t failures_seen = 0;
+  std::size_t refused_moves = 0;  ///< move() calls that failed in this session
+  int first_refusal_code = RTC_OK;
+  std::string first_refusal;
+  std::map<std::uint64_t, std::string> motion_names;  ///< motion id -> position name
+  std::string message;                                ///< the last error's
+};
+
+State& state() {
+  static State s;
+  return s;
+}
+
+rccl_trsf t6_box{rc::t6()};
+rccl_trsf eq_mark{};
+rccl_trsf tl_mark{};
+POS park_box{1, "park"};
+
+enum class Say : bool { quiet, print };
+
+/// Records an error: rtc_error, the message, and (Say::print) a line on stderr.
+int fail(int code, std::string_view text, Say say) noexcept {
+  rtc_error = code;
+  try {
+    state().message.assign(text);
+  } catch (...) {  // no memory for the text: the code still tells
+  }
+  if (say == Say::print)
+    std::fprintf(stderr, "rccl: %.*s\n", static_cast<int>(text.size()), text.data());
+  return code;
+}
+
+/// Runs `body` (which returns an error code); an exception becomes an error code. `invalid` is
+/// the code for std::invalid_argument, whose meaning depends on the call.
+template <class F>
+int guarded(const char* call, Say say, int invalid, F&& body) noexcept {
+  const auto failed = [&](int code, const char* what) noexcept {
+    try {
+      return fail(code, fmt::format("{}: {}", call, what), say);
+    } catch (...) {
+      return fail(code, what, say);
+    }
+  };
+  try {
+    return body();
+  } catch (const rc::EquationError& e) {
+    return failed(RTC_E_EQUATION, e.what());
+  } catch (const rc::MotionError& e) {
+    return failed(RTC_E_UNREACHABLE, e.what());
+  } catch (const kin::RobotFileError& e) {
+    return failed(RTC_E_ROBOT, e.what());
+  } catch (const rtc::LogError& e) {
+    return failed(RTC_E_OPEN, e.what());
+  } catch (const rtc::SessionError& e) {
+    return failed(RTC_E_OPEN, e.what());
+  } catch (const std::invalid_argument& e) {
+    return failed(invalid, e.what());
+  } catch (const std::exception& e) {
+    return failed(RTC_E_INTERNAL, e.what());
+  } catch (...) {
+    return failed(RTC_E_INTERNAL, "an unknown exception");
+  }
+}
+
+bool finite(std::initializer_list<double> values) noexcept {
+  for (const double v : values) {
+    if (!std::isfinite(v)) return false;
+  }
+  return true;
+}
+
+/// Brings POS.end and `completed` up to date with the trajectory generator.
+void refresh() noexcept {
+  State& s = state();
+  for (auto& [key, box] : s.positions) {
+    box->c.end = box->position->pending_ends.load(std::memory_order_acquire) <= 0 ? 1 : 0;
+  }
+  if (s.arm) {
+    park_box.end = s.arm->park()->pending_ends.load(std::memory_order_acquire) <= 0 ? 1 : 0;
+    completed = s.arm->happened(rc::Manipulator::completed()) ? 1 : 0;
+  } else {
+    park_box.end = 1;
+    completed = 1;
+  }
+}
+
+std::string motion_name(const State& s, std::uint64_t id) {
+  const auto it = s.motion_names.find(id);
+  return it == s.motion_names.end() ? fmt::format("motion {}", id)
+                                    : fmt::format("motion {} (to {})", id, it->second);
+}
+
+std::string describe_end(const rtc::Termination& t) {
+  std::string out = fmt::format("control ended at t = {:.3f} s with {} ({}", t.time_s,
+                                rtc::to_string(t.code), static_cast<int>(t.code));
+  if (t.joint > 0) out += fmt::format(", joint {}", t.joint);
+  out += fmt::format("): {}", rtc::describe(t.code));
+  if (!t.detail_view().empty()) out += fmt::format("; {}", t.detail_view());
+  if (!t.message_view().empty()) out += fmt::format("; rtc_message \"{}\"", t.message_view());
+  return out;
+}
+
+/// Control has ended by itself: RTC_E_TERMINATED, printed the first time only.
+int control_ended(std::string_view call) {
+  State& s = state();
+  const Say say = s.told_ended ? Say::quiet : Say::print;
+  s.told_ended = true;
+  return fail(RTC_E_TERMINATED,
+              fmt::format("{}: {}; rccl_close() the session", call,
+                          describe_end(s.robot->session->termination())),
+              say);
+}
+
+/// Prints the motions that failed since the last call (and how many were cancelled after).
+void report_failures() {
+  State& s = state();
+  const std::vector<rc::MotionEvent>& f = s.arm->failures();
+  std::size_t cancelled = 0;
+  for (; s.failures_seen < f.size(); ++s.failures_seen) {
+    const rc::MotionEvent& e = f[s.failures_seen];
+    if (e.kind == rc::EventKind::failed) {
+      fail(RTC_E_MOTION,
+           fmt::format("{} failed at t = {:.3f} s: {}; the arm stops where it is",
+                       motion_name(s, e.id), e.t_s, e.message()),
+           Say::print);
+    } else {
+      ++cancelled;
+    }
+  }
+  if (cancelled > 0) {
+    std::fprintf(stderr, "rccl: %zu queued motion(s) cancelled\n", cancelled);
+  }
+}
+
+kin::RobotModel choose_robot(const char* robot) {
+  std::string name = robot != nullptr ? robot : "";
+  if (name.empty()) {
+    if (const char* env = std::getenv("RCCX_ROBOT"); env != nullptr) name = env;
+  }
+  if (name.empty()) name = "microbo";
+  const bool file = name.find('/') != std::string::npos || name.ends_with(".json");
+  return file ? kin::load_robot_file(name) : kin::builtin_robot(name);
+}
+
+/// The separated arguments of makeposition, read before anything can throw.
+struct EquationArgs {
+  static constexpr std::size_t kMax = 64;
+  std::array<TRSF_PTR, kMax> t{};
+  std::size_t count = 0;
+  std::size_t eq = 0, tl = 0;  ///< indices of EQ and TL in t
+  std::string_view problem;    ///< why reading stopped early
+};
+
+/// Reads up to the transform after TL. Stops at a NULL, an unknown pointer (it is not
+/// dereferenced), EQ twice, TL before EQ or twice: what follows may not be arguments at all.
+void read_equation(std::va_list ap, EquationArgs& a) noexcept {
+  const State& s = state();
+  enum { left, right, tool } part = left;
+  for (;;) {
+    if (a.count == EquationArgs::kMax) {
+      a.problem = "more than 64 arguments: is EQ or TL missing?";
+      return;
+    }
+    TRSF_PTR t = va_arg(ap, TRSF_PTR);
+    a.t[a.count++] = t;
+    if (t == nullptr) {
+      a.problem = "a NULL transform (did gen_tr_rot fail?)";
+      return;
+    }
+    if (t == &eq_mark) {
+      if (part != left) {
+        a.problem = part == right ? "EQ twice" : "EQ after TL";
+        return;
+      }
+      a.eq = a.count - 1;
+      part = right;
+      continue;
+    }
+    if (t == &tl_mark) {
+      if (part != right) {
+        a.problem = part == left ? "TL before EQ" : "TL twice";
+        return;
+      }
+      a.tl = a.count - 1;
+      part = tool;
+      continue;
+    }
+    if (t != &t6_box && s.transforms.find(t) == s.transforms.end()) {
+      a.problem = "a pointer that is not a transform (made by gen_tr_rot, or t6)";
+      return;
+    }
+    if (part == tool) return;
+  }
+}
+
+}  // namespace
+
+extern "C" {
+
+int rtc_error = RTC_OK;
+int completed = 1;
+const VECT xunit = {1.0, 0.0, 0.0};
+const VECT yunit = {0.0, 1.0, 0.0};
+const VECT zunit = {0.0, 0.0, 1.0};
+TRSF_PTR const t6 = &t6_box;
+TRSF_PTR const rccl_EQ = &eq_mark;
+TRSF_PTR const rccl_TL = &tl_mark;
+POS_PTR const park = &park_box;
+
+const char* rtc_error_name(int code) {
+  switch (code) {
+    case RTC_OK:
+      return "RTC_OK";
+    case RTC_E_SEQUENCE:
+      return "RTC_E_SEQUENCE";
+    case RTC_E_ROBOT:
+      return "RTC_E_ROBOT";
+    case RTC_E_OPEN:
+      return "RTC_E_OPEN";
+    case RTC_E_ARGUMENT:
+      return "RTC_E_ARGUMENT";
+    case RTC_E_EQUATION:
+      return "RTC_E_EQUATION";
+    case RTC_E_UNREACHABLE:
+      return "RTC_E_UNREACHABLE";
+    case RTC_E_MOTION:
+      return "RTC_E_MOTION";
+    case RTC_E_TERMINATED:
+      return "RTC_E_TERMINATED";
+    case RTC_E_INTERNAL:
+      return "RTC_E_INTERNAL";
+    default:
+      return "unknown";
+  }
+}
+
+const char* rtc_error_message(void) {
+  return state().message.c_str();
+}
+
+void print_rtc_error(int code, int /*flags*/) {
+  static constexpr std::array<const char*, 10> kMeaning = {
+      "no error",
+      "a call out of order (open, control, move, close)",
+      "no such robot, or it cannot be simulated",
+      "the control session cannot open",
+      "a bad argument",
+      "a malformed position equation",
+      "a motion that cannot be queued",
+      "a motion failed while it ran",
+      "control ended",
+      "an unexpected failure inside rccx",
+  };
+  const char* meaning = code >= 0 && code < static_cast<int>(kMeaning.size())
+                            ? kMeaning[static_cast<std::size_t>(code)]
+                            : "an unknown error code";
+  const char* message = rtc_error_message();
+  if (code != RTC_OK && code == rtc_error && message[0] != '\0') meaning = message;
+  std::printf("rtc error %d (%s): %s\n", code, rtc_error_name(code), meaning);
+  std::fflush(stdout);
+}
+
+TRSF_PTR gen_tr_rot(const char* name, double x_mm, double y_mm, double z_mm, VECT axis,
+                    double angle_deg) {
+  TRSF_PTR out = nullptr;
+  guarded("gen_tr_rot", Say::print, RTC_E_ARGUMENT, [&] {
+    const std::string n = name != nullptr ? name : "?";
+    if (!finite({x_mm, y_mm, z_mm, axis.x, axis.y, axis.z, angle_deg})) {
+      return fail(RTC_E_ARGUMENT,
+                  fmt::format("gen_tr_rot({}): every number must be finite (got {}, {}, {} mm, "
+                              "axis ({}, {}, {}), {} deg)",
+                              n, x_mm, y_mm, z_mm, axis.x, axis.y, axis.z, angle_deg),
+                  Say::print);
+    }
+    const math::Vec3 a{axis.x, axis.y, axis.z};
+    if (!(a.norm() > 0.0)) {
+      return fail(RTC_E_ARGUMENT,
+                  fmt::format("gen_tr_rot({}): the rotation axis is zero; use xunit, yunit, "
+                              "zunit or any nonzero VECT",
+                              n),
+                  Say::print);
+    }
+    const math::Transform value{math::Rot3::about(a, math::deg_to_rad(angle_deg)),
+                                {x_mm * 1e-3, y_mm * 1e-3, z_mm * 1e-3}};
+    auto box = std::make_unique<rccl_trsf>(rccl_trsf{rc::constant(n, value)});
+    TRSF_PTR t = box.get();
+    state().transforms.emplace(t, std::move(box));
+    out = t;
+    return RTC_OK;
+  });
+  return out;
+}
+
+POS_PTR makeposition(const char* name, ...) {
+  EquationArgs a;
+  std::va_list ap;
+  va_start(ap, name);
+  read_equation(ap, a);
+  va_end(ap);
+
+  POS_PTR out = nullptr;
+  guarded("makeposition", Say::print, RTC_E_EQUATION, [&] {
+    const std::string n = name != nullptr ? name : "?";
+    if (!a.problem.empty()) {
+      return fail(RTC_E_EQUATION,
+                  fmt::format("makeposition({}): argument {} after the name: {}; write "
+                              "makeposition(name, left side (t6 among it), EQ, right side, "
+                              "TL, tool), e.g. makeposition(\"P1\", t6, EQ, b, TL, t6)",
+                              n, a.count, a.problem),
+                  Say::print);
+    }
+    std::vector<rc::TransformPtr> lhs, rhs;
+    for (std::size_t i = 0; i < a.eq; ++i) lhs.push_back(a.t[i]->transform);
+    for (std::size_t i = a.eq + 1; i < a.tl; ++i) rhs.push_back(a.t[i]->transform);
+    const rc::TransformPtr& tool = a.t[a.tl + 1]->transform;
+    auto box = std::make_unique<PositionBox>();
+    box->name = n;
+    box->position = rc::Position::make(n, lhs, rhs, tool);
+    box->c.name = box->name.c_str();
+    POS_PTR p = &box->c;
+    state().positions.emplace(p, std::move(box));
+    out = p;
+    return RTC_OK;
+  });
+  return out;
+}
+
+int rccl_open(const char* robot, double period_ms) {
+  return guarded("rccl_open", Say::quiet, RTC_E_ROBOT, [&] {
+    State& s = state();
+    if (s.robot) {
+      return fail(RTC_E_SEQUENCE, "rccl_open: a session is open already; rccl_close() it first",
+                  Say::quiet);
+    }
+    if (!(period_ms >= 0.0) || !std::isfinite(period_ms)) {
+      return fail(RTC_E_ARGUMENT,
+                  fmt::format("rccl_open: the period is 0 (the robot's usual one) or 0.25 .. "
+                              "56 ms, got {}",
+                              period_ms),
+                  Say::quiet);
+    }
+    rtc::SimulatedRobotOptions options;  // simulated time; the log from RCCX_LOG (the session)
+    options.period = std::chrono::nanoseconds(std::llround(period_ms * 1e6));
+    auto robot_sim = std::make_unique<rtc::SimulatedRobot>(choose_robot(robot), options);
+    auto arm = std::make_unique<rc::Manipulator>(*robot_sim->session);
+    s.robot = std::move(robot_sim);
+    s.arm = std::move(arm);
+    s.controlling = false;
+    s.told_ended = false;
+    s.failures_seen = 0;
+    s.refused_moves = 0;
+    s.first_refusal.clear();
+    s.motion_names.clear();
+    refresh();
+    return RTC_OK;
+  });
+}
+
+int rccl_control(void) {
+  return guarded("rccl_control", Say::quiet, RTC_E_INTERNAL, [] {
+    State& s = state();
+    if (!s.arm) return fail(RTC_E_SEQUENCE, "rccl_control: call rccl_open() first", Say::quiet);
+    if (s.controlling) {
+      return fail(RTC_E_SEQUENCE, "rccl_control: the trajectory generator runs already",
+                  Say::quiet);
+    }
+    s.arm->start();
+    s.controlling = true;
+    refresh();
+    return RTC_OK;
+  });
+}
+
+int rccl_close(int power_off) {
+  return guarded("rccl_close", Say::quiet, RTC_E_INTERNAL, [&] {
+    State& s = state();
+    if (!s.robot) return fail(RTC_E_SEQUENCE, "rccl_close: no session is open", Say::quiet);
+    // Whatever happens below, the session is gone afterwards.
+    struct Closer {
+      State& s;
+      ~Closer() {
+        s.arm.reset();
+        s.robot.reset();
+        // Motions still queued will never end now.
+        for (auto& [key, box] : s.positions) box->position->pending_ends.store(0);
+        s.controlling = false;
+        s.motion_names.clear();
+        refresh();
+      }
+    } closer{s};
+
+    int code = RTC_OK;
+    std::string why;
+    if (s.controlling) report_failures();
+    const rtc::Termination t =
+        s.controlling ? s.arm->stop_control() : s.robot->session->termination();
+    const std::vector<rc::MotionEvent>& failures = s.arm->failures();
+    if (t.ended()) {
+      code = RTC_E_TERMINATED;
+      why = describe_end(t);
+    } else if (!failures.empty()) {
+      const rc::MotionEvent& first = failures.front();
+      code = RTC_E_MOTION;
+      why = fmt::format("{} motion(s) failed or were cancelled during the session; first {} {}{}{}",
+                        failures.size(), motion_name(s, first.id), rc::to_string(first.kind),
+                        first.message().empty() ? "" : ": ", first.message());
+    } else if (s.refused_moves > 0) {
+      code = s.first_refusal_code;
+      why = fmt::format("{} move() call(s) were refused during the session; the first: {}",
+                        s.refused_moves, s.first_refusal);
+    }
+    s.robot->session->close(power_off != 0);
+    return code == RTC_OK ? RTC_OK : fail(code, "rccl_close: " + why, Say::quiet);
+  });
+}
+
+int setvel(double mm_per_s, double deg_per_s) {
+  return guarded("setvel", Say::print, RTC_E_ARGUMENT, [&] {
+    if (!(mm_per_s > 0.0) || !(deg_per_s > 0.0) || !finite({mm_per_s, deg_per_s})) {
+      return fail(RTC_E_ARGUMENT,
+                  fmt::format("setvel({}, {}): both speeds must be finite and > 0 (mm/s, deg/s)",
+                              mm_per_s, deg_per_s),
+                  Say::print);
+    }
+    State& s = state();
+    s.settings.translation_m_per_s = mm_per_s * 1e-3;
+    s.settings.rotation_rad_per_s = math::deg_to_rad(deg_per_s);
+    return RTC_OK;
+  });
+}
+
+int setmod(int mode) {
+  return guarded("setmod", Say::print, RTC_E_ARGUMENT, [&] {
+    State& s = state();
+    if (mode == 'j' || mode == 'J') {
+      s.settings.mode = rc::Mode::joint;
+    } else if (mode == 'c' || mode == 'C') {
+      s.settings.mode = rc::Mode::cartesian;
+    } else {
+      const std::string got = mode > ' ' && mode < 127
+                                  ? fmt::format("'{}'", static_cast<char>(mode))
+                                  : fmt::format("{}", mode);
+      return fail(RTC_E_ARGUMENT,
+                  fmt::format("setmod({}): the mode is 'j' (joint) or 'c' (Cartesian)", got),
+                  Say::print);
+    }
+    return RTC_OK;
+  });
+}
+
+int settime(double transition_ms, double segment_ms) {
+  return guarded("settime", Say::print, RTC_E_ARGUMENT, [&] {
+    if (!(transition_ms > 0.0) || !(segment_ms >= 0.0) || !finite({transition_ms, segment_ms})) {
+      return fail(RTC_E_ARGUMENT,
+                  fmt::format("settime({}, {}): the transition time (ms) must be > 0 and the "
+                              "segment time (ms) >= 0 (0: from the speeds of setvel)",
+                              transition_ms, segment_ms),
+                  Say::print);
+    }
+    State& s = state();
+    s.settings.transition_time_s = transition_ms * 1e-3;
+    s.settings.segment_time_s = segment_ms * 1e-3;
+    return RTC_OK;
+  });
+}
+
+int move(POS_PTR p) {
+  const int code = guarded("move", Say::print, RTC_E_ARGUMENT, [&] {
+    State& s = state();
+    if (p == nullptr) {
+      return fail(RTC_E_ARGUMENT, "move(NULL): no position (did makeposition fail?)", Say::print);
+    }
+    const auto it = s.positions.find(p);
+    if (p != park && it == s.positions.end()) {
+      return fail(RTC_E_ARGUMENT,
+                  fmt::format("move: {} is not a position made by makeposition() (or park)",
+                              static_cast<const void*>(p)),
+                  Say::print);
+    }
+    const std::string name = p == park ? "park" : it->second->name;
+    if (!s.arm || !s.controlling) {
+      return fail(RTC_E_SEQUENCE,
+                  fmt::format("move({}): call rccl_open() and rccl_control() before move()", name),
+                  Say::print);
+    }
+    if (!s.robot->session->controlling()) return control_ended("move(" + name + ")");
+    const rc::PositionPtr& target = p == park ? s.arm->park() : it->second->position;
+    s.arm->set_mode(s.settings.mode);
+    s.arm->set_velocity(s.settings.translation_m_per_s, s.settings.rotation_rad_per_s);
+    s.arm->set_segment_time(s.settings.segment_time_s);
+    s.arm->set_transition_time(s.settings.transition_time_s);
+    const rc::Motion m = s.arm->move(target);
+    s.motion_names[m.id] = name;
+    refresh();
+    return RTC_OK;
+  });
+  // A 1986 program does not look at move()'s result: rccl_close() will tell.
+  State& s = state();
+  if (code != RTC_OK && s.robot && ++s.refused_moves == 1) {
+    s.first_refusal_code = code;
+    try {
+      s.first_refusal = rtc_error_message();
+    } catch (...) {
+    }
+  }
+  return code;
+}
+
+int rccl_wait_sample(void) {
+  return guarded("waitfor", Say::print, RTC_E_INTERNAL, [] {
+    State& s = state();
+    if (!s.arm || !s.controlling) {
+      return fail(RTC_E_SEQUENCE,
+                  "waitfor: nothing runs to wait on; call rccl_open() and rccl_control() first",
+                  Say::print);
+    }
+    rtc::Session& session = *s.robot->session;
+    if (session.controlling()) session.wait_for(session.period());
+    report_failures();
+    refresh();
+    if (!session.controlling()) return control_ended("waitfor");
+    return RTC_OK;
+  });
+}
+
+}  // extern "C"

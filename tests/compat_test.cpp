@@ -1,0 +1,156 @@
+// The C compatibility layer (compat/rccl.h, compat/rtc.h): its error paths set rtc_error and a
+// message and never abort; waitfor over POS.end and `completed` on the simulated Microbo.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <string>
+
+#include "rccl.h"
+#include "rtc.h"
+
+namespace {
+
+std::string message() {
+  return rtc_error_message();
+}
+
+// Each test starts with no session and no error.
+class Compat : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    rtc_error = RTC_OK;
+    ::unsetenv("RCCX_ROBOT");
+  }
+  void TearDown() override {
+    rccl_close(0);  // RTC_E_SEQUENCE when no session is open
+  }
+};
+
+TEST_F(Compat, MakepositionWithoutEqIsNullAndSaysHowToWriteIt) {
+  TRSF_PTR b = gen_tr_rot("B", 325.0, 150.0, 300.0, xunit, 180.0);
+  ASSERT_NE(b, nullptr);
+  EXPECT_EQ(makeposition("P", t6, b, TL, t6), nullptr);
+  EXPECT_EQ(rtc_error, RTC_E_EQUATION);
+  EXPECT_NE(message().find("TL before EQ"), std::string::npos) << message();
+  EXPECT_NE(message().find("makeposition(\"P1\", t6, EQ, b, TL, t6)"), std::string::npos);
+
+  rtc_error = RTC_OK;
+  EXPECT_EQ(makeposition("P", t6, EQ, nullptr, TL, t6), nullptr);
+  EXPECT_EQ(rtc_error, RTC_E_EQUATION);
+  EXPECT_NE(message().find("NULL"), std::string::npos) << message();
+
+  // Well formed as a list, wrong as an equation: T6 on the right side.
+  rtc_error = RTC_OK;
+  EXPECT_EQ(makeposition("P", b, EQ, t6, TL, b), nullptr);
+  EXPECT_EQ(rtc_error, RTC_E_EQUATION);
+  EXPECT_NE(message().find("position P"), std::string::npos) << message();
+
+  rtc_error = RTC_OK;
+  POS_PTR p = makeposition("P", t6, EQ, b, TL, t6);
+  ASSERT_NE(p, nullptr);
+  EXPECT_EQ(rtc_error, RTC_OK);
+  EXPECT_STREQ(p->name, "P");
+  EXPECT_EQ(p->end, 1);
+}
+
+TEST_F(Compat, BadArgumentsAreRefused) {
+  const VECT zero = {0.0, 0.0, 0.0};
+  EXPECT_EQ(gen_tr_rot("Z", 0.0, 0.0, 0.0, zero, 90.0), nullptr);
+  EXPECT_EQ(rtc_error, RTC_E_ARGUMENT);
+  EXPECT_NE(message().find("axis is zero"), std::string::npos) << message();
+  EXPECT_EQ(setvel(0, 100), RTC_E_ARGUMENT);
+  EXPECT_EQ(setvel(100, -1), RTC_E_ARGUMENT);
+  EXPECT_EQ(setmod('x'), RTC_E_ARGUMENT);
+  EXPECT_EQ(settime(0, 0), RTC_E_ARGUMENT);
+  EXPECT_EQ(settime(100, -1), RTC_E_ARGUMENT);
+  EXPECT_EQ(move(nullptr), RTC_E_ARGUMENT);
+  POS not_made_here{0, "fake"};
+  EXPECT_EQ(move(&not_made_here), RTC_E_ARGUMENT);
+  EXPECT_EQ(setvel(100, 100), RTC_OK);  // the defaults, for the tests after this one
+  EXPECT_EQ(setmod('j'), RTC_OK);
+  EXPECT_EQ(settime(200, 0), RTC_OK);
+}
+
+TEST_F(Compat, CallsOutOfOrderAreSequenceErrors) {
+  EXPECT_EQ(rccl_close(0), RTC_E_SEQUENCE);
+  EXPECT_EQ(rccl_control(), RTC_E_SEQUENCE);
+  EXPECT_EQ(move(park), RTC_E_SEQUENCE);
+  EXPECT_EQ(rccl_wait_sample(), RTC_E_SEQUENCE);
+  int never = 0;
+  waitfor(never);  // returns: nothing runs that could make it true
+  EXPECT_EQ(rtc_error, RTC_E_SEQUENCE);
+
+  ASSERT_EQ(rccl_open("microbo", 0), RTC_OK) << message();
+  EXPECT_EQ(rccl_open("microbo", 0), RTC_E_SEQUENCE);
+  EXPECT_EQ(move(park), RTC_E_SEQUENCE);  // before rccl_control
+  ASSERT_EQ(rccl_control(), RTC_OK);
+  EXPECT_EQ(rccl_control(), RTC_E_SEQUENCE);
+  // The refused move() makes the session fail, for programs that check only rccl_close().
+  EXPECT_EQ(rccl_close(0), RTC_E_SEQUENCE);
+  EXPECT_NE(message().find("1 move() call(s) were refused"), std::string::npos) << message();
+  EXPECT_EQ(rccl_close(0), RTC_E_SEQUENCE);  // closed all the same
+  EXPECT_NE(message().find("no session is open"), std::string::npos) << message();
+}
+
+TEST_F(Compat, UnknownRobotAndBadPeriod) {
+  EXPECT_EQ(rccl_open("no_such_robot", 0), RTC_E_ROBOT);
+  EXPECT_NE(message().find("microbo"), std::string::npos) << message();  // lists the known
+  ::setenv("RCCX_ROBOT", "no_such_robot", 1);
+  EXPECT_EQ(rccl_open(nullptr, 0), RTC_E_ROBOT);
+  ::unsetenv("RCCX_ROBOT");
+  EXPECT_EQ(rccl_open(nullptr, 1000), RTC_E_OPEN);
+  EXPECT_EQ(rccl_open(nullptr, -1), RTC_E_ARGUMENT);
+}
+
+TEST_F(Compat, WaitforEndAndCompletedOnTheSimulatedMicrobo) {
+  TRSF_PTR b = gen_tr_rot("B", 325.0, 150.0, 300.0, xunit, 180.0);
+  TRSF_PTR c = gen_tr_rot("C", 325.0, -150.0, 300.0, xunit, 180.0);
+  TRSF_PTR far = gen_tr_rot("FAR", 3000.0, 0.0, 300.0, xunit, 180.0);
+  POS_PTR p1 = makeposition("P1", t6, EQ, b, TL, t6);
+  POS_PTR p2 = makeposition("P2", t6, EQ, c, TL, t6);
+  POS_PTR unreachable = makeposition("FAR", t6, EQ, far, TL, t6);
+  ASSERT_NE(p1, nullptr);
+  ASSERT_NE(p2, nullptr);
+  ASSERT_NE(unreachable, nullptr);
+
+  ASSERT_EQ(rccl_open(nullptr, 0), RTC_OK) << message();
+  ASSERT_EQ(rccl_control(), RTC_OK) << message();
+  EXPECT_EQ(park->end, 1);
+  EXPECT_EQ(completed, 1);
+
+  ASSERT_EQ(move(park), RTC_OK) << message();
+  EXPECT_EQ(park->end, 0);  // at once: nothing ran yet
+  EXPECT_EQ(completed, 0);
+  waitfor(park->end);
+  EXPECT_EQ(park->end, 1);
+  EXPECT_EQ(completed, 1);
+
+  ASSERT_EQ(move(p1), RTC_OK) << message();
+  waitfor(p1->end);
+  ASSERT_EQ(setmod('c'), RTC_OK);
+  ASSERT_EQ(move(p2), RTC_OK) << message();  // along the window's top edge
+  ASSERT_EQ(move(p1), RTC_OK) << message();  // and back: joined by a transition
+  EXPECT_EQ(p1->end, 0);
+  EXPECT_EQ(p2->end, 0);
+  waitfor(completed);
+  EXPECT_EQ(p1->end, 1);
+  EXPECT_EQ(p2->end, 1);
+  EXPECT_EQ(setmod('j'), RTC_OK);
+
+  rtc_error = RTC_OK;
+  EXPECT_EQ(rccl_close(0), RTC_OK) << message();
+  EXPECT_EQ(rtc_error, RTC_OK);
+  EXPECT_EQ(park->end, 1);
+
+  // A goal out of reach is refused at move(), queuing nothing; rccl_close() reports it.
+  ASSERT_EQ(rccl_open(nullptr, 0), RTC_OK) << message();
+  ASSERT_EQ(rccl_control(), RTC_OK) << message();
+  EXPECT_EQ(move(unreachable), RTC_E_UNREACHABLE);
+  EXPECT_NE(message().find("FAR"), std::string::npos) << message();
+  EXPECT_EQ(unreachable->end, 1);
+  EXPECT_EQ(completed, 1);
+  EXPECT_EQ(rccl_close(0), RTC_E_UNREACHABLE);
+  EXPECT_NE(message().find("position FAR cannot be reached"), std::string::npos) << message();
+}
+
+}  // namespace
