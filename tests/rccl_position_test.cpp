@@ -48,20 +48,29 @@ TEST(Position, MalformedEquationsAreRefusedWithTheReason) {
   using rccl::Position;
   EXPECT_NE(equation_error([&] { Position::make("P", {a}, {b}, t6); }).find("T6"),
             std::string::npos);
-  EXPECT_NE(equation_error([&] { Position::make("P", {a}, {t6, b}, t6); }).find("T6"),
+  EXPECT_NE(equation_error([&] {
+              Position::make("P", {a}, {t6, b}, t6);
+            }).find("T6"),
             std::string::npos);
-  EXPECT_NE(equation_error([&] { Position::make("P", {t6, t6}, {b}, t6); }).find("T6"),
+  EXPECT_NE(equation_error([&] {
+              Position::make("P", {t6, t6}, {b}, t6);
+            }).find("T6"),
             std::string::npos);
   EXPECT_NE(equation_error([&] { Position::make("P", {t6}, {}, t6); }), "");
   EXPECT_NE(equation_error([&] { Position::make("P", {t6}, {b}, tool); }).find("TOOL"),
             std::string::npos);  // the tool is not in the equation
-  EXPECT_NE(equation_error([&] { Position::make("P", {tool, t6}, {b}, tool); }).find("TOOL"),
+  EXPECT_NE(equation_error([&] {
+              Position::make("P", {tool, t6}, {b}, tool);
+            }).find("TOOL"),
             std::string::npos);  // the tool before T6
-  EXPECT_NE(equation_error([&] { Position::make("P", {t6, a}, {a, b}, t6); }).find("A"),
+  EXPECT_NE(equation_error([&] {
+              Position::make("P", {t6, a}, {a, b}, t6);
+            }).find("A"),
             std::string::npos);  // a transform twice
   EXPECT_NE(equation_error([&] { Position::make("P", {t6, nullptr}, {b}, t6); }), "");
   std::vector<rccl::TransformPtr> holds;
-  for (std::size_t i = 0; i <= rccl::kMaxHolds; ++i) holds.push_back(rccl::hold("H" + std::to_string(i)));
+  for (std::size_t i = 0; i <= rccl::kMaxHolds; ++i)
+    holds.push_back(rccl::hold("H" + std::to_string(i)));
   EXPECT_NE(equation_error([&] { Position::make("P", {t6}, holds, t6); }), "");
   EXPECT_NO_THROW(Position::make("P", {a, t6, tool}, {b}, tool));
 }
@@ -93,8 +102,9 @@ TEST(Position, GoalAndToolSolveTheEquationWithConstantsFolded) {
     const auto t6 = rccl::t6();
     const auto b2 = rccl::constant("B2", B2);
     const auto p = rccl::Position::make(
-        "P", {rccl::constant("A1", A1), rccl::constant("A2", A2), t6, rccl::constant("B1", B1), b2,
-              rccl::constant("B3", B3)},
+        "P",
+        {rccl::constant("A1", A1), rccl::constant("A2", A2), t6, rccl::constant("B1", B1), b2,
+         rccl::constant("B3", B3)},
         {rccl::constant("C1", C1), conv, rccl::constant("C2", C2), rccl::constant("C3", C3)}, b2);
     ASSERT_TRUE(p->moves());
     EXPECT_EQ(p->goal_factor_count(), 3u);  // (A2⁻¹ A1⁻¹ C1) CONV (C2 C3 B3⁻¹)
@@ -125,8 +135,8 @@ TEST(Position, FunctionalTransformsAreEvaluatedOncePerSample) {
 TEST(Position, HoldTransformsLatchTheValueWhenTheMotionStarts) {
   const auto h = rccl::hold("GRASP", math::Transform::translation(0, 0, 0.1));
   const auto t6 = rccl::t6();
-  const auto p = rccl::Position::make(
-      "P", {t6}, {rccl::constant("OBJ", math::Transform::identity()), h}, t6);
+  const auto p =
+      rccl::Position::make("P", {t6}, {rccl::constant("OBJ", math::Transform::identity()), h}, t6);
   EXPECT_FALSE(p->moves());
   EXPECT_NEAR(p->t6_now().p.z, 0.1, 1e-15);
   rccl::LatchedHolds first;

@@ -300,6 +300,17 @@ bool TrajectoryGenerator::build(const MotionRequest& r, const SampleContext& ctx
                   100.0 * k / kChecks, kin::describe(why)));
         return false;
       }
+      const int jumping = find_jump(s, ctx, static_cast<double>(k - 1) / kChecks,
+                                    static_cast<double>(k) / kChecks, q_prev, q);
+      if (jumping > 0) {
+        fail(r.id, ctx, kin::IkStatus::singular, jumping,
+             text("the straight line to {} passes through a singularity about {:.0f}% of the "
+                  "way: joint {} would jump there (or it is at the end of its turns); go round "
+                  "it (another line or a via point) "
+                  "or move in joint mode",
+                  name, 100.0 * (k - 0.5) / kChecks, jumping));
+        return false;
+      }
       joint_time(q_prev, q, kChecks);
       for (std::size_t j = 0; j < n; ++j) end_step[j] = (q[j] - q_prev[j]) * kChecks;
       q_prev = q;
@@ -334,6 +345,40 @@ bool TrajectoryGenerator::build(const MotionRequest& r, const SampleContext& ctx
   return true;
 }
 
+int TrajectoryGenerator::find_jump(const Segment& s, const SampleContext& ctx, double r0, double r1,
+                                   const JointVector& q0, const JointVector& q1) const {
+  // A joint that turns a lot between two points of the line is either fast there (fine, the
+  // segment time allows for it) or jumping: a change of solution branch at a singularity.
+  // Halving the interval tells them apart: a smooth change halves, a jump stays.
+  constexpr double kLargeStep_rad = 0.3;
+  int joint = -1;
+  double largest = kLargeStep_rad;
+  for (std::size_t j = 0; j < q0.size(); ++j) {
+    if (std::abs(q1[j] - q0[j]) > largest) {
+      largest = std::abs(q1[j] - q0[j]);
+      joint = static_cast<int>(j);
+    }
+  }
+  if (joint < 0) return 0;
+  const auto J = static_cast<std::size_t>(joint);
+  JointVector lo = q0, hi = q1, mid;
+  kin::IkStatus why;
+  for (int i = 0; i < 12; ++i) {  // 4096 times shorter
+    const double rm = 0.5 * (r0 + r1);
+    Pose p;
+    pose_at(s, ctx, rm, p);
+    if (!solve(s, p.t6, lo, mid, why)) return 0;  // the caller's checks report it
+    if (std::abs(mid[J] - lo[J]) > std::abs(hi[J] - mid[J])) {
+      r1 = rm;
+      hi = mid;
+    } else {
+      r0 = rm;
+      lo = mid;
+    }
+  }
+  return std::abs(hi[J] - lo[J]) > 0.5 * largest ? joint + 1 : 0;
+}
+
 // --- Transitions ---------------------------------------------------------------------------------
 
 TrajectoryGenerator::Blend TrajectoryGenerator::blend_between(const Segment& a,
@@ -342,7 +387,11 @@ TrajectoryGenerator::Blend TrajectoryGenerator::blend_between(const Segment& a,
   const bool a_linear = a.kind == K::joint || a.kind == K::rest;
   if (b == nullptr) return a.kind == K::cartesian ? Blend::paul_r_out : Blend::paul_joint;
   if (a_linear && b->kind != K::cartesian) return Blend::paul_joint;
-  if (a.kind == K::rest && b->kind == K::cartesian) return Blend::paul_r_in;
+  if (a.kind == K::rest && b->kind == K::cartesian) {
+    // A line that starts on a moving goal moves with it from its first sample: blend it in
+    // from the pose at rest, so that the goal's speed is taken up over the transition.
+    return b->position->moves() ? Blend::smooth_pose : Blend::paul_r_in;
+  }
   if (a.kind == K::cartesian && b->kind == K::cartesian) return Blend::smooth_pose;
   return Blend::smooth_joint;
 }
@@ -547,10 +596,15 @@ bool TrajectoryGenerator::blend_value(const Segment& a, const Segment& b, bool t
     }
     case Blend::smooth_pose: {
       Pose pa, pb;
-      pose_at(a, ctx, drive_fraction(a, t), pa);
+      if (a.kind == Segment::Kind::rest) {
+        pa.t6 = kin_.forward(a.q1);
+      } else {
+        pose_at(a, ctx, drive_fraction(a, t), pa);
+      }
       pose_at(b, ctx, drive_fraction(b, t), pb);
       const double s = smoothstep((t - (tB - tau)) / (2.0 * tau));
-      return solve(s < 0.5 ? a : b, interpolate(pa.t6, pb.t6, s), near, q, why);
+      const bool on_a = s < 0.5 && a.kind != Segment::Kind::rest;
+      return solve(on_a ? a : b, interpolate(pa.t6, pb.t6, s), near, q, why);
     }
     case Blend::smooth_joint: {
       JointVector qa, qb;

@@ -207,6 +207,10 @@ class TrajectoryGenerator {
   [[nodiscard]] Segment rest_of(const Segment& a) const noexcept;
 
   bool build(const MotionRequest& r, const SampleContext& ctx, double t_via);
+  /// The 1-based joint whose solution jumps between drive fractions r0 and r1 of Cartesian
+  /// segment s (solved as q0, q1): a singularity on the line. 0: none.
+  [[nodiscard]] int find_jump(const Segment& s, const SampleContext& ctx, double r0, double r1,
+                              const kin::JointVector& q0, const kin::JointVector& q1) const;
   [[nodiscard]] Blend blend_between(const Segment& a, const Segment* b) const noexcept;
   /// Half the transition from a into b at via time tB, from the change of joint velocity and
   /// the acceleration bound; lengthens b (not started yet) when a has too little room left.
