@@ -25,11 +25,9 @@ build-debug: deps $(DEBUG_DIR)/CMakeCache.txt
 build-release: deps $(RELEASE_DIR)/CMakeCache.txt
 	$(CMAKE) --build $(RELEASE_DIR) -j$(JOBS)
 
-# The main examples on simulated robots: kinematics of the thesis's robots, an RTC session.
+# The main example: the thesis's window washer in RCCL motion equations, on the simulated Microbo.
 demo: build-release
-	$(RELEASE_DIR)/examples/01_kinematics
-	@echo
-	$(RELEASE_DIR)/examples/02_rtc_session
+	$(RELEASE_DIR)/examples/04_washer
 
 # Debug build with AddressSanitizer and UndefinedBehaviorSanitizer, then every test.
 test: build-debug

@@ -12,6 +12,7 @@
 // Run: ./build/release/examples/04_washer          (examples/washer.c is the 1986 text in C)
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <vector>
 
 #include "rccx/math/units.hpp"
@@ -67,6 +68,7 @@ int main() {
       "\n seg  mode       start s   end s   T s   path error mm (cmd / measured)  "
       "approach deg  top speed mm/s\n");
   std::vector<double> round_error(3, 0.0);
+  double worst_approach_deg = 0.0;
   for (std::size_t i = 0; i < motions.size(); ++i) {
     const rccl::SegmentReport r = arm.report(motions[i]);
     const bool cart = r.mode == rccl::Mode::cartesian;
@@ -80,6 +82,7 @@ int main() {
                  math::rad_to_deg(r.max_approach_error_rad), r.peak_tool_speed_m_per_s * 1e3);
       const std::size_t round = (i - 2) / 4;
       round_error[round] = std::max(round_error[round], r.max_measured_path_error_m * 1e3);
+      worst_approach_deg = std::max(worst_approach_deg, math::rad_to_deg(r.max_approach_error_rad));
     }
     fmt::print("{}\n", r.failed ? "  FAILED" : "");
   }
@@ -88,6 +91,12 @@ int main() {
     fmt::print("  round {} at {:.0f} mm/s: measured tool point within {:.3f} mm of the edges\n",
                i + 1, round_speed[i], round_error[i]);
   }
+  const double total_s = arm.report(motions.back()).end_s - arm.report(motions.front()).start_s;
+  fmt::print(
+      "\nwasher: {} segments in {:.2f} s, the window followed 3 times at {:.0f}/{:.0f}/{:.0f} "
+      "mm/s, largest measured path error {:.3f} mm, approach error {:.3f} deg\n",
+      motions.size(), total_s, round_speed[0], round_speed[1], round_speed[2],
+      *std::max_element(round_error.begin(), round_error.end()), worst_approach_deg);
   for (const rccl::MotionEvent& f : arm.failures()) {
     fmt::print(stderr, "motion {} {}: {}\n", f.id, rccl::to_string(f.kind), f.message());
   }

@@ -307,6 +307,23 @@ TEST(GeneratorSingularity, LineThroughTheWristSingularityIsReportedBeforeMoving)
   EXPECT_EQ(run.events.back().kind, EventKind::ended);
 }
 
+// A Cartesian move down from 20 mm under the Microbo's vertical limit (d2 <= 330 mm), queued
+// straight after a joint move: the transition between them blends both segments extended past
+// their ends, and the line extended back above its start would pass the limit; it is continued
+// in joint space there, and the program runs within the bounds.
+TEST(GeneratorLimits, TransitionNextToALimitStaysWithinIt) {
+  GeneratorRun run("microbo", 0.028);
+  const math::Rot3 down = math::Rot3::rot_x(180_deg);
+  run.move(pose_position("UP", {down, {0.350, -0.120, 0.310}}), joint_settings());
+  const auto last =
+      run.move(pose_position("DOWN", {down, {0.350, -0.120, 0.240}}), cartesian_settings(0.1));
+  ASSERT_TRUE(run.run_until_ended(last));
+  ASSERT_EQ(run.find_event(EventKind::failed), nullptr)
+      << run.find_event(EventKind::failed)->message();
+  expect_within_limits_and_speeds(run);
+  EXPECT_LE(worst_velocity_jump(run), 1.0 + 1e-3);
+}
+
 INSTANTIATE_TEST_SUITE_P(Robots, Generator, ::testing::Values("microbo", "puma560"),
                          [](const ::testing::TestParamInfo<const char*>& p) {
                            return std::string(p.param);

@@ -178,10 +178,25 @@ bool TrajectoryGenerator::segment_value(const Segment& s, const SampleContext& c
       return true;
     }
     case Segment::Kind::cartesian: {
+      const double r = drive_fraction(s, t);
       Pose p;
-      pose_at(s, ctx, drive_fraction(s, t), p);
+      pose_at(s, ctx, r, p);
       if (pose) *pose = p;
-      return solve(s, p.t6, near, q, why);
+      if (solve(s, p.t6, near, q, why)) return true;
+      if (r >= 0.0 && r <= 1.0) return false;
+      // Past its ends (a transition blends the segments extended beyond them) the line may
+      // leave the workspace or a joint's limits although the blend does not: continue it in
+      // joint space there, at the rate it has at its end.
+      const double r_end = r < 0.0 ? 0.0 : 1.0;
+      const double h = r < 0.0 ? 0.01 : -0.01;  // a step back onto the line
+      Pose pe, pi;
+      pose_at(s, ctx, r_end, pe);
+      pose_at(s, ctx, r_end + h, pi);
+      JointVector q_end, q_in;
+      if (!solve(s, pe.t6, near, q_end, why) || !solve(s, pi.t6, q_end, q_in, why)) return false;
+      q = q_end;
+      for (std::size_t j = 0; j < q.size(); ++j) q[j] += (q_in[j] - q_end[j]) / h * (r - r_end);
+      return true;
     }
   }
   return false;
@@ -487,9 +502,9 @@ double TrajectoryGenerator::blend_acceleration_ratio(const Segment& a, const Seg
     return blend_value(a, b, to_next, blend, tB, tau, ctx, t, seed, q, why);
   };
   double t = tB - tau;
-  if (!at(t - P, near, q0) || !at(t, q0, q1)) return 0.0;
+  if (!at(t - P, near, q0) || !at(t, q0, q1)) return -1.0;
   for (; t <= tB + tau; t += P) {
-    if (!at(t + P, q1, q2)) return 0.0;  // the loop will report it
+    if (!at(t + P, q1, q2)) return -1.0;
     for (std::size_t j = 0; j < q1.size(); ++j) {
       const double acc = std::abs(q2[j] - 2.0 * q1[j] + q0[j]) / (P * P);
       worst = std::max(worst, acc / options_.max_acceleration[j]);

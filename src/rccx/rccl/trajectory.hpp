@@ -219,6 +219,7 @@ class TrajectoryGenerator {
   /// The largest joint acceleration of the transition from a into b, sampled every period,
   /// as a multiple of the joint's bound.
   /// `near`: joint values close to the transition's start, to seed the inverse kinematics.
+  /// Negative when a sample of the transition has no solution.
   double blend_acceleration_ratio(const Segment& a, const Segment& b, bool to_next, Blend blend,
                                   double tB, double tau, const kin::JointVector& near,
                                   const SampleContext& ctx) const;

@@ -5,7 +5,9 @@
 //   functional  a user function gives its value; the trajectory generator evaluates it at most
 //               once per sample (a conveyor moving at a set speed, a sensor reading).
 //   hold        set by the planning level at any time; a motion that uses it latches the value
-//               it has when that motion starts, so a queued update reaches the next motion.
+//               it has when the trajectory generator takes that motion from the queue: when
+//               the motion before it begins (up to one segment ahead of its own start), or at
+//               once from rest. A set() after that reaches the next motion that uses it.
 //
 // And T6 itself, the pose of the last link in the robot's base frame: `t6()`.
 //
