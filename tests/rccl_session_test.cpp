@@ -111,6 +111,8 @@ TEST(RcclSession, WasherLogShowsTheWindowFollowedOnItsEdges) {
   std::vector<math::Vec3> corners;
   std::vector<std::uint64_t> cartesian;
   double period_s = 0;
+  std::uint64_t park_id = 0;
+  kin::JointVector ready;
   {
     rtc::SimulatedRobot robot(kin::builtin_robot("microbo"), o);
     period_s = robot.period_s();
@@ -132,6 +134,11 @@ TEST(RcclSession, WasherLogShowsTheWindowFollowedOnItsEdges) {
       arm.set_velocity(0.1 + 0.005 * (round + 1), (100 + 10 * (round + 1)) * 1_deg);
     }
     ASSERT_EQ(arm.waitfor(arm.completed()), rccl::WaitResult::reached);
+    arm.set_mode(rccl::Mode::joint);  // back to park in joint mode, as the thesis does
+    park_id = arm.move(arm.park()).id;
+    ASSERT_EQ(arm.waitfor(arm.completed()), rccl::WaitResult::reached);
+    robot.session->wait_for(500ms);  // rows at rest
+    ready = robot.model.ready();
     events = arm.take_events();
     ASSERT_TRUE(arm.failures().empty());
     ASSERT_FALSE(arm.stop_control().ended());
@@ -155,7 +162,8 @@ TEST(RcclSession, WasherLogShowsTheWindowFollowedOnItsEdges) {
     const double end =
         i + 1 < cartesian.size() ? time_of(rccl::EventKind::started, id + 1) - 2 * period_s : 1e9;
     for (const LogRow& r : rows) {
-      if (r.seg == static_cast<int>(id) || r.seg == static_cast<int>(id) + 1) {
+      const bool next_cartesian = i + 1 < cartesian.size();
+      if (r.seg == static_cast<int>(id) || (next_cartesian && r.seg == static_cast<int>(id) + 1)) {
         EXPECT_NEAR(r.a.z, -1.0, 1e-6) << "approach at t = " << r.t;
         EXPECT_NEAR(r.p.x, 0.325, 1e-6) << "the window's plane at t = " << r.t;
       }
@@ -176,6 +184,17 @@ TEST(RcclSession, WasherLogShowsTheWindowFollowedOnItsEdges) {
   EXPECT_GT(judged, 200u);
   EXPECT_LT(worst_commanded, 1e-4);
   EXPECT_LT(worst_measured, 3e-3);  // the emulated RCU's servo lag, joint by joint
+
+  // Joint mode ends exactly on its end point: the commanded joints of the rows after park's
+  // end are the ready pose (to the log's 9 significant digits).
+  const double park_end = time_of(rccl::EventKind::ended, park_id);
+  std::size_t at_rest = 0;
+  for (const LogRow& r : rows) {
+    if (r.t < park_end + 2 * period_s) continue;
+    ++at_rest;
+    for (std::size_t j = 0; j < 6; ++j) EXPECT_NEAR(r.q[j], ready[j], 5e-9) << "joint " << j + 1;
+  }
+  EXPECT_GE(at_rest, 8u);
 }
 
 // A box on a conveyor at 50 mm/s: once the motion onto it has ended the measured tool point
