@@ -154,6 +154,40 @@ TEST(Position, HoldTransformsLatchTheValueWhenTheMotionStarts) {
                std::logic_error);
 }
 
+// RCCL's update: solve one transform so that the equation holds at a given T6, with the unknown
+// on the right side (a taught object: T6 TOOL = CONV OBJ) or on the left (a calibrated base:
+// BASE T6 TOOL = OBJ), functional transforms at their present value.
+TEST(Position, SolveForMakesTheEquationHoldAtTheGivenT6) {
+  std::mt19937 rng(11);
+  for (int trial = 0; trial < 50; ++trial) {
+    const math::Transform T6 = random_transform(rng), TOOL = random_transform(rng),
+                          CONV = random_transform(rng), A = random_transform(rng),
+                          C = random_transform(rng);
+    const auto t6 = rccl::t6();
+    const auto tool = rccl::constant("TOOL", TOOL);
+    const auto conv = rccl::functional("CONV", [&](const rccl::SampleContext&) { return CONV; });
+    const auto obj = rccl::hold("OBJ");
+    const auto right =
+        rccl::Position::make("R", {t6, tool}, {conv, obj, rccl::constant("C", C)}, tool);
+    const math::Transform OBJ = right->solve_for(*obj, T6);
+    EXPECT_LT(difference(T6 * TOOL, CONV * OBJ * C), 1e-9);
+
+    const auto base = rccl::hold("BASE");
+    const auto left = rccl::Position::make("L", {rccl::constant("A", A), base, t6, tool},
+                                           {rccl::constant("O", CONV)}, tool);
+    const math::Transform BASE = left->solve_for(*base, T6);
+    EXPECT_LT(difference(A * BASE * T6 * TOOL, CONV), 1e-9);
+    // Stored in the hold, the equation's T6 is the one taught.
+    base->set(BASE);
+    EXPECT_LT(difference(left->t6_now(), T6), 1e-9);
+  }
+  const auto t6 = rccl::t6();
+  const auto p = rccl::Position::make("P", {t6}, {rccl::hold("H")}, t6);
+  EXPECT_THROW((void)p->solve_for(*t6, math::Transform::identity()), EquationError);
+  EXPECT_THROW((void)p->solve_for(*rccl::hold("ELSEWHERE"), math::Transform::identity()),
+               EquationError);
+}
+
 TEST(Position, DescribeWritesTheEquation) {
   const auto tool = rccl::constant("TOOL", math::Transform::translation(0, 0, 0.1));
   const auto p = rccl::Position::make("P", {rccl::t6(), tool},

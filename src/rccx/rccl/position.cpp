@@ -165,6 +165,46 @@ void Position::evaluate(const SampleContext& ctx, const LatchedHolds& holds, mat
   tool = product(tool_, ctx, holds);
 }
 
+math::Transform Position::solve_for(const Transform& x, const math::Transform& t6,
+                                    const SampleContext& ctx) const {
+  if (in_joints_) throw EquationError(fmt::format("position {} is given in joints", name_));
+  if (x.kind() == TransformKind::t6) {
+    throw EquationError(
+        fmt::format("position {}: T6 is what the equation solves for; name "
+                    "another of its transforms",
+                    describe()));
+  }
+  // L1 X L2 = R (x on the left) or L = R1 X R2 (on the right): X = L1⁻¹ R L2⁻¹ or R1⁻¹ L R2⁻¹.
+  const auto value = [&](const TransformPtr& t) {
+    return t->kind() == TransformKind::t6 ? t6 : t->value_now(ctx);
+  };
+  const auto split = [&](const std::vector<TransformPtr>& side, math::Transform& before,
+                         math::Transform& after) {
+    bool found = false;
+    before = after = math::Transform::identity();
+    for (const TransformPtr& t : side) {
+      if (t.get() == &x) {
+        found = true;
+      } else if (found) {
+        after = after * value(t);
+      } else {
+        before = before * value(t);
+      }
+    }
+    return found;
+  };
+  const auto product = [&](const std::vector<TransformPtr>& side) {
+    math::Transform p = math::Transform::identity();
+    for (const TransformPtr& t : side) p = p * value(t);
+    return p;
+  };
+  math::Transform before, after;
+  if (split(lhs_, before, after)) return before.inverse() * product(rhs_) * after.inverse();
+  if (split(rhs_, before, after)) return before.inverse() * product(lhs_) * after.inverse();
+  throw EquationError(
+      fmt::format("position {}: transform {} is not in the equation", describe(), x.name()));
+}
+
 math::Transform Position::t6_now() const {
   if (moves_) {
     throw std::logic_error(fmt::format(

@@ -73,6 +73,13 @@ class Position {
   /// positions without functional transforms (otherwise std::logic_error).
   [[nodiscard]] math::Transform t6_now() const;
 
+  /// RCCL's update (thesis 4.5.4.4): the value transform `x` must have for the equation to hold
+  /// with T6 = `t6` (m, rad), the other transforms at their present values (functional ones
+  /// called with `ctx`). `x` may stand on either side, but is not T6. Throws EquationError
+  /// when `x` is not in the equation or is T6. Teach stores the result (a hold: set()).
+  [[nodiscard]] math::Transform solve_for(const Transform& x, const math::Transform& t6,
+                                          const SampleContext& ctx = {}) const;
+
   // --- Sample loop -------------------------------------------------------------------------
   /// Latches the hold transforms' present values.
   void latch(LatchedHolds& holds) const noexcept;

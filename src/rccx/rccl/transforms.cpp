@@ -53,6 +53,17 @@ void Transform::set(const math::Transform& value) {
   published_.publish(value);
 }
 
+math::Transform Transform::value_now(const SampleContext& ctx) const {
+  switch (kind_) {
+    case TransformKind::functional:
+      return function_(ctx);
+    case TransformKind::t6:
+      throw std::logic_error("T6 has no value of its own: it is the unknown");
+    default:
+      return planning_value_;
+  }
+}
+
 const math::Transform& Transform::evaluate(const SampleContext& ctx) const {
   if (ctx.sample != loop_sample_ || ctx.sample == 0) {
     loop_value_ = function_(ctx);

@@ -68,6 +68,10 @@ class Transform {
 
   // --- Sample loop (the trajectory generator's thread) ---------------------------------------
 
+  /// Planning level: the value now - a constant's or hold's value(), a functional's function
+  /// called afresh with `ctx` (not the loop's cached value). T6 has none: std::logic_error.
+  [[nodiscard]] math::Transform value_now(const SampleContext& ctx) const;
+
   /// A functional transform's value at this sample, computed once per sample number.
   [[nodiscard]] const math::Transform& evaluate(const SampleContext& ctx) const;
   /// A hold transform's value as the loop sees it now (the newest set() taken).
