@@ -2,12 +2,16 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
@@ -355,3 +359,43 @@ TEST(CliRtc, MarshOnTheMicroboLetsAPushedJointStayWhereItIsLeft) {
   EXPECT_GT(d3[2], ready_mm + 0.2) << "d3 did not follow the push";
   EXPECT_NEAR(d3[3], d3[2], 0.01) << "d3 did not stay where it was left";
 }
+
+namespace {
+
+// `rccx db`: put, show, export, import into another file, export again: the same text, so
+// positions round-trip exactly through JSON (and version control); refusals exit non-zero.
+TEST(Cli, DbExportThenImportRoundTripsExactly) {
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("rccx_cli_db_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string a = (dir / "a.db").string(), b = (dir / "b.db").string();
+  const std::string e1 = (dir / "a.json").string(), e2 = (dir / "b.json").string();
+  const math::Transform pick{math::Rot3::rot_x(3.14159265358979) * math::Rot3::rot_z(0.1),
+                             {0.325, 0.15, 0.25}};
+  ASSERT_EQ(rccx_cli("db --db " + a + " put --robot microbo PICK --T " + pose_argument(pick), true)
+                .exit_code,
+            0);
+  const CliRun show = rccx_cli("db --db " + a + " show --robot microbo PICK", true);
+  EXPECT_EQ(show.exit_code, 0);
+  EXPECT_NE(show.out.find("x 325.000 y 150.000 z 250.000 mm"), std::string::npos) << show.out;
+  EXPECT_NE(rccx_cli("db --db " + a + " put --robot microbo BAD --T 1,0,0,0,0,1,0,0,0,0,2,0", true)
+                .exit_code,
+            0);
+  ASSERT_EQ(rccx_cli("db --db " + a + " export " + e1, true).exit_code, 0);
+  ASSERT_EQ(rccx_cli("db --db " + b + " import " + e1, true).exit_code, 0);
+  ASSERT_EQ(rccx_cli("db --db " + b + " export " + e2, true).exit_code, 0);
+  std::ifstream f1(e1), f2(e2);
+  const std::string s1((std::istreambuf_iterator<char>(f1)), {});
+  const std::string s2((std::istreambuf_iterator<char>(f2)), {});
+  EXPECT_FALSE(s1.empty());
+  EXPECT_EQ(s1, s2);
+  const json j = json::parse(s1);
+  ASSERT_EQ(j["transforms"].size(), 1u);
+  for (std::size_t i = 0; i < 12; ++i) {
+    EXPECT_EQ(j["transforms"][0]["T_rows_m"][i].get<double>(), pick.rows()[i]);  // exact
+  }
+  EXPECT_NE(rccx_cli("db --db " + (dir / "missing.db").string() + " list", true).exit_code, 0);
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace

@@ -3,6 +3,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "db_command.hpp"
 #include "kin_command.hpp"
 #include "rcu_command.hpp"
 #include "rtc_commands.hpp"
@@ -17,6 +18,7 @@ int main(int argc, char** argv) {
   rccx::tools::add_kin_command(app, exit_code);
   rccx::tools::add_rtc_commands(app, exit_code);
   rccx::tools::add_rcu_command(app, exit_code);
+  rccx::tools::add_db_command(app, exit_code);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

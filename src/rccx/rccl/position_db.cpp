@@ -211,7 +211,7 @@ std::optional<StoredTransform> PositionDb::get(std::string_view robot,
   return row(s);
 }
 
-void PositionDb::put(const StoredTransform& t) {
+void PositionDb::check(const StoredTransform& t) {
   check_name(t.name);
   if (t.robot.empty()) throw DatabaseError(fmt::format("transform {}: name its robot", t.name));
   if (!is_rigid(t.value)) {
@@ -220,14 +220,30 @@ void PositionDb::put(const StoredTransform& t) {
                     "orthonormal and right-handed, every element finite)",
                     t.name));
   }
+}
+
+void PositionDb::put(const StoredTransform& t) {
+  check(t);
   Transaction tr(db_, path_);
+  insert(t);
+  tr.commit();
+}
+
+void PositionDb::put(const std::vector<StoredTransform>& all) {
+  for (const StoredTransform& t : all) check(t);
+  Transaction tr(db_, path_);
+  for (const StoredTransform& t : all) insert(t);
+  tr.commit();
+}
+
+void PositionDb::insert(const StoredTransform& t) {
   const std::int64_t now = now_unix_s();
   Statement s(db_,
               fmt::format("INSERT INTO transforms ({}) VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, "
-                          "?9, ?10, ?11, ?12, ?13, ?14, ?15, ?16, ?17, ?17) "
+                          "?9, ?10, ?11, ?12, ?13, ?14, ?15, ?16, ?17, ?18) "
                           "ON CONFLICT (robot, name) DO UPDATE SET nx = ?3, ny = ?4, nz = ?5, "
                           "ox = ?6, oy = ?7, oz = ?8, ax = ?9, ay = ?10, az = ?11, px = ?12, "
-                          "py = ?13, pz = ?14, configuration = ?15, note = ?16, changed = ?17",
+                          "py = ?13, pz = ?14, configuration = ?15, note = ?16, changed = ?18",
                           kColumns),
               path_);
   s.bind(1, t.robot);
@@ -238,9 +254,10 @@ void PositionDb::put(const StoredTransform& t) {
   for (int i = 0; i < 12; ++i) s.bind(3 + i, v[static_cast<std::size_t>(i)]);
   s.bind(15, t.configuration);
   s.bind(16, t.note);
+  // Times given (an import) are kept; a new put is stamped now.
   s.bind(17, t.created_unix_s > 0 ? t.created_unix_s : now);
+  s.bind(18, t.changed_unix_s > 0 ? t.changed_unix_s : now);
   s.step(path_);
-  tr.commit();
 }
 
 bool PositionDb::remove(std::string_view robot, std::string_view name) {

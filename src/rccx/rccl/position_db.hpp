@@ -44,8 +44,8 @@ struct StoredTransform {
   /// The arm configuration it was taught in ("lun" ...), or empty.
   std::string configuration;
   std::string note;
-  std::int64_t created_unix_s = 0;  ///< set by put() the first time
-  std::int64_t changed_unix_s = 0;  ///< set by every put()
+  std::int64_t created_unix_s = 0;  ///< 0: put() stamps it the first time (an import keeps it)
+  std::int64_t changed_unix_s = 0;  ///< 0: put() stamps it now (an import keeps it)
 };
 
 class PositionDb {
@@ -69,6 +69,8 @@ class PositionDb {
                                                    std::string_view name) const;
   /// Stores `t` (inserting or replacing; created time kept), in one transaction.
   void put(const StoredTransform& t);
+  /// Stores them all in one transaction: every one or none (each checked first).
+  void put(const std::vector<StoredTransform>& all);
   /// Removes it; false when there was none.
   bool remove(std::string_view robot, std::string_view name);
   /// The transforms of `robot` (every robot when empty) whose names match the glob `pattern`
@@ -90,6 +92,8 @@ class PositionDb {
 
  private:
   void migrate();
+  static void check(const StoredTransform& t);
+  void insert(const StoredTransform& t);
   [[nodiscard]] StoredTransform require(std::string_view robot, std::string_view name) const;
 
   std::filesystem::path path_;
