@@ -301,6 +301,7 @@ bool TrajectoryGenerator::build(const MotionRequest& r, const SampleContext& ctx
   } else {
     s.kind = Segment::Kind::cartesian;
     s.drive = math::DriveTransform(offset, math::Transform::identity());
+    s.start_in_goal = s.drive.at(0.0);
     // Walk the line before moving: a point out of reach or out of limits, or a joint that would
     // need more than its speed, is reported now rather than in the middle of the motion.
     constexpr int kChecks = 16;
@@ -703,10 +704,10 @@ void TrajectoryGenerator::fail(std::uint64_t id, const SampleContext& ctx, kin::
   tr_.active = false;
   started_.store(std::max(started_.load(), last), std::memory_order_release);
   ended_.store(last, std::memory_order_release);
-  start_halt(ctx);
+  start_halt();
 }
 
-void TrajectoryGenerator::start_halt(const SampleContext& ctx) noexcept {
+void TrajectoryGenerator::start_halt() noexcept {
   const double P = options_.period_s;
   halt_ = Halt{};
   halt_.active = true;
@@ -727,7 +728,6 @@ void TrajectoryGenerator::start_halt(const SampleContext& ctx) noexcept {
     if (std::abs(v) * Ts / 2.0 > room) stop = 2.0 * std::max(room, 0.0) / std::abs(v);
     halt_.stop_time[j] = stop;
   }
-  (void)ctx;
 }
 
 void TrajectoryGenerator::halt_value(double t, JointVector& q) noexcept {
@@ -867,13 +867,12 @@ std::uint64_t TrajectoryGenerator::step(const SampleContext& ctx, const JointVec
 
 void TrajectoryGenerator::record(const SampleContext& ctx, const JointVector& q,
                                  const JointVector* measured) noexcept {
-  (void)q;
   if (tr_.active || halt_.active || cur_.id == 0) return;
   SegmentReport& rep = reports_[cur_.id % kReports];
   if (rep.id != cur_.id || !pose_valid_) return;
   const double P = options_.period_s;
   // The line as it stands for the present goal: from the start to the goal, in base frame.
-  const math::Vec3 from = (pose_.goal * cur_.drive.at(0.0)).p;
+  const math::Vec3 from = (pose_.goal * cur_.start_in_goal).p;
   const math::Vec3 to = pose_.goal.p;
   ++rep.straight_samples;
   rep.max_commanded_path_error_m =

@@ -167,8 +167,9 @@ class TrajectoryGenerator {
     double stop_tau = 0.0;     ///< half the transition to rest at its end, s
     kin::JointVector q0, q1;   ///< joint: from, to; rest: q1 is where it stays
     LatchedHolds holds;
-    math::Transform fixed_goal;  ///< a position given in joints: its T6
-    math::DriveTransform drive;  ///< cartesian: from the start (in the goal's frame) to I
+    math::Transform fixed_goal;     ///< a position given in joints: its T6
+    math::DriveTransform drive;     ///< cartesian: from the start (in the goal's frame) to I
+    math::Transform start_in_goal;  ///< cartesian: drive.at(0), the line's start in G's frame
     kin::Configuration configuration;
     bool has_configuration = false;
   };
@@ -238,7 +239,7 @@ class TrajectoryGenerator {
   void end_motion(const Segment& s, const SampleContext& ctx) noexcept;
   void fail(std::uint64_t id, const SampleContext& ctx, kin::IkStatus status, int joint,
             const Text& text) noexcept;
-  void start_halt(const SampleContext& ctx) noexcept;
+  void start_halt() noexcept;
   void halt_value(double t, kin::JointVector& q) noexcept;
   void rest_at(const kin::JointVector& q) noexcept;
   void record(const SampleContext& ctx, const kin::JointVector& q,
