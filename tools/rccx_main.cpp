@@ -7,6 +7,7 @@
 #include "kin_command.hpp"
 #include "rcu_command.hpp"
 #include "rtc_commands.hpp"
+#include "teach_command.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{
@@ -19,6 +20,7 @@ int main(int argc, char** argv) {
   rccx::tools::add_rtc_commands(app, exit_code);
   rccx::tools::add_rcu_command(app, exit_code);
   rccx::tools::add_db_command(app, exit_code);
+  rccx::tools::add_teach_command(app, exit_code);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

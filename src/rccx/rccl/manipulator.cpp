@@ -54,6 +54,7 @@ Manipulator::~Manipulator() {
 
 void Manipulator::start() {
   first_sample_ = true;
+  limp_ = zero_gravity_ = false;
   session_.control({}, [this](rtc::Control& c) {
     const rtc::How& h = c.how();
     const kin::JointVector measured = h.q();
@@ -62,6 +63,24 @@ void Manipulator::start() {
     if (first_sample_) {
       generator_->reset(measured, t_set);
       first_sample_ = false;
+    }
+    if (const rtc::Request hand = hand_request_.exchange(rtc::Request::none);
+        hand != rtc::Request::none) {
+      c.chg().hand = hand;
+    }
+    if (const rtc::SettingChg set = setting_request_.exchange(rtc::SettingChg{});
+        set.what != rtc::Setting::none) {
+      c.chg().setting = set;
+    }
+    if (const rtc::Request zg = zero_gravity_request_.exchange(rtc::Request::none);
+        zg != rtc::Request::none) {
+      c.chg().zero_gravity = zg;
+      limp_ = zg == rtc::Request::on;
+      if (!limp_) generator_->reset(measured, t_set);  // at rest where the hand left it
+    }
+    if (limp_) {
+      c.chg().zero_gravity = rtc::Request::on;  // held every sample, as marsh does
+      return;
     }
     const SampleContext ctx{t_set, h.sample, &h};
     kin::JointVector q;
@@ -153,6 +172,7 @@ void Manipulator::check_reachable(const Position& p) const {
 
 Motion Manipulator::submit(MotionRequest r, const PositionPtr& keep) {
   if (!started_) throw MotionError("call start() (rccl_control) before queuing motions");
+  if (zero_gravity_) throw MotionError("zero gravity is on: set_zero_gravity(false) first");
   r.id = next_id_;
   r.settings = settings_;
   if (keep && std::find(keep_.begin(), keep_.end(), keep) == keep_.end()) keep_.push_back(keep);
@@ -183,6 +203,20 @@ Motion Manipulator::dwell(double seconds) {
   r.kind = RequestKind::dwell;
   r.dwell_s = seconds;
   return submit(r, nullptr);
+}
+
+void Manipulator::set_zero_gravity(bool on) {
+  if (!started_) throw MotionError("call start() (rccl_control) before zero gravity");
+  if (on == zero_gravity_) return;
+  if (on && !happened(completed())) {
+    throw MotionError("zero gravity only at rest: waitfor(completed()) first");
+  }
+  zero_gravity_ = on;
+  zero_gravity_request_.store(on ? rtc::Request::on : rtc::Request::off);
+}
+
+void Manipulator::set_hand(bool closed) noexcept {
+  hand_request_.store(closed ? rtc::Request::on : rtc::Request::off);
 }
 
 void Manipulator::halt() {

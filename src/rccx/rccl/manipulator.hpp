@@ -14,6 +14,7 @@
 // back the same way. Waiting lets simulated time run, so a simulated program is deterministic.
 #pragma once
 
+#include <atomic>
 #include <chrono>
 #include <cstdint>
 #include <memory>
@@ -94,6 +95,16 @@ class Manipulator {
   Motion dwell(double seconds);
   /// Stops smoothly where the arm is and cancels everything queued.
   void halt();
+  /// Zero gravity ("marsh"): on, the generator stops commanding and the joints follow a push
+  /// and stay; off, the generator starts again at rest where the arm was left. Only with
+  /// nothing queued or moving (MotionError otherwise). Takes effect at the next sample.
+  void set_zero_gravity(bool on);
+  [[nodiscard]] bool zero_gravity() const noexcept { return zero_gravity_; }
+  /// Closes (true) or opens the hand, at the next sample.
+  void set_hand(bool closed) noexcept;
+  /// A joint controller setting (the Microbo's, e.g. Setting::examine to read its motor
+  /// parameters into How), sent with the next sample.
+  void send_setting(const rtc::SettingChg& setting) noexcept { setting_request_.store(setting); }
   /// The robot's park position (its ready pose, in joints).
   [[nodiscard]] const PositionPtr& park() const noexcept { return park_; }
 
@@ -137,7 +148,13 @@ class Manipulator {
   std::vector<PositionPtr> keep_;  ///< positions the loop may still point to
   std::uint64_t next_id_ = 1;
   bool started_ = false;
-  bool first_sample_ = true;  ///< loop side: reset the generator at the arm's position
+  bool first_sample_ = true;   ///< loop side: reset the generator at the arm's position
+  bool zero_gravity_ = false;  ///< planning side: as last set
+  // Planning -> loop, one-shot requests (Request::none once the loop has sent them).
+  std::atomic<rtc::Request> zero_gravity_request_{rtc::Request::none};
+  std::atomic<rtc::Request> hand_request_{rtc::Request::none};
+  std::atomic<rtc::SettingChg> setting_request_{rtc::SettingChg{}};
+  bool limp_ = false;  ///< loop side: zero gravity is on, nothing is commanded
   std::vector<MotionEvent> failures_;
   std::vector<MotionEvent> pending_events_;
   std::set<std::uint64_t> failed_ids_;

@@ -205,6 +205,18 @@ math::Transform Position::solve_for(const Transform& x, const math::Transform& t
       fmt::format("position {}: transform {} is not in the equation", describe(), x.name()));
 }
 
+math::Transform Position::tool_now() const {
+  for (const Factor& f : tool_) {
+    if (f.kind == TransformKind::functional) {
+      throw std::logic_error(fmt::format(
+          "position {}: its tool has functional transforms, known only in the sample loop", name_));
+    }
+  }
+  LatchedHolds holds;
+  for (std::uint8_t i = 0; i < hold_count_; ++i) holds.values[i] = holds_[i]->value();
+  return product(tool_, {}, holds);
+}
+
 math::Transform Position::t6_now() const {
   if (moves_) {
     throw std::logic_error(fmt::format(

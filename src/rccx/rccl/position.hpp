@@ -72,6 +72,8 @@ class Position {
   /// Planning level: T6 for the present values (hold transforms as last set). Only for
   /// positions without functional transforms (otherwise std::logic_error).
   [[nodiscard]] math::Transform t6_now() const;
+  /// Planning level: the tool product B1 .. Bj (identity for a position in joints).
+  [[nodiscard]] math::Transform tool_now() const;
 
   /// RCCL's update (thesis 4.5.4.4): the value transform `x` must have for the equation to hold
   /// with T6 = `t6` (m, rad), the other transforms at their present values (functional ones
