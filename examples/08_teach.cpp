@@ -37,7 +37,7 @@ int main(int argc, char** argv) {
 
   // What an operator types: three positions, each reached a different way, each saved.
   std::istringstream script(
-      "m 1 20\n"              // joint 1 to 20 deg
+      "m 1 20\n"  // joint 1 to 20 deg
       "save A\n"
       "p\ns 30\nz-\nx+\nq\n"  // pendant: 30 mm down, 30 mm along x
       "save B\n"

@@ -16,6 +16,7 @@
 
 #include "rccx/math/units.hpp"
 #include "rccx/rccl/position_db.hpp"
+#include "temp_db.hpp"
 
 namespace {
 
@@ -25,20 +26,7 @@ using rccl::DatabaseError;
 using rccl::PositionDb;
 using rccl::StoredTransform;
 
-/// A fresh file name in the temporary folder, removed (with its WAL files) at the end.
-struct TempDb {
-  TempDb() {
-    static int n = 0;
-    path = std::filesystem::temp_directory_path() /
-           ("rccx_db_test_" + std::to_string(::getpid()) + "_" + std::to_string(n++) + ".db");
-    clean();
-  }
-  ~TempDb() { clean(); }
-  void clean() const {
-    for (const char* s : {"", "-wal", "-shm"}) std::filesystem::remove(path.string() + s);
-  }
-  std::filesystem::path path;
-};
+using test::TempDb;
 
 StoredTransform sample(const std::string& robot, const std::string& name, double x) {
   StoredTransform t;

@@ -9,24 +9,14 @@
 #include "rccx/math/units.hpp"
 #include "rccx/rccl/teach.hpp"
 #include "rccx/rtc/simulated_robot.hpp"
+#include "temp_db.hpp"
 
 namespace {
 
 using namespace rccx;
 using namespace rccx::math::literals;
 
-struct TempDb {
-  TempDb()
-      : path(std::filesystem::temp_directory_path() /
-             ("rccx_teach_test_" + std::to_string(::getpid()) + ".db")) {
-    clean();
-  }
-  ~TempDb() { clean(); }
-  void clean() const {
-    for (const char* s : {"", "-wal", "-shm"}) std::filesystem::remove(path.string() + s);
-  }
-  std::filesystem::path path;
-};
+using test::TempDb;
 
 TEST(Teach, MoveAJointExamineAndSaveByName) {
   TempDb file;

@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <CLI/CLI.hpp>
+#include <cstdlib>
 #include <memory>
 #include <string>
 
@@ -50,6 +51,13 @@ inline void add_robot_options(CLI::App& cmd, RobotChoice& robot) {
   cmd.add_option("--robot-file", robot.file,
                  "Robot description file (JSON, see robots/README.md); overrides --robot")
       ->check(CLI::ExistingFile);
+}
+
+/// The position database file: `given`, else $RCCX_DB, else ./rccx.db (one file per cell).
+inline std::string database_file(const std::string& given) {
+  if (!given.empty()) return given;
+  if (const char* env = std::getenv("RCCX_DB"); env != nullptr && *env != '\0') return env;
+  return "rccx.db";
 }
 
 /// Runs a subcommand, turning a BadArgument into its message and exit code 2.

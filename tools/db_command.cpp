@@ -25,12 +25,6 @@ struct DbArgs {
   std::string path;  // export / import file ("-": stdout / stdin)
 };
 
-std::string database_path(const DbArgs& a) {
-  if (!a.file.empty()) return a.file;
-  if (const char* env = std::getenv("RCCX_DB"); env != nullptr && *env != '\0') return env;
-  return "rccx.db";
-}
-
 json to_json(const rccl::StoredTransform& t) {
   json j;
   j["robot"] = t.robot;
@@ -66,7 +60,7 @@ void print(const rccl::StoredTransform& t) {
 
 int run(const std::string& what, const DbArgs& a) {
   using rccl::PositionDb;
-  const std::string file = database_path(a);
+  const std::string file = database_file(a.file);
   try {
     if (what == "list") {
       PositionDb db(file, PositionDb::Open::existing);

@@ -16,11 +16,7 @@ struct TeachArgs {
 };
 
 int run_teach(const TeachArgs& a) {
-  std::string file = a.db;
-  if (file.empty()) {
-    const char* env = std::getenv("RCCX_DB");
-    file = env != nullptr && *env != '\0' ? env : "rccx.db";
-  }
+  const std::string file = database_file(a.db);
   try {
     rccl::PositionDb db(file);
     rtc::SimulatedRobot robot(a.robot.model());

@@ -75,8 +75,8 @@ class Loop {
 
   std::size_t joint_index(int j) const {
     if (j < 1 || static_cast<std::size_t>(j) > model_.dof()) {
-      throw std::invalid_argument(fmt::format("joint {}: the robot has joints 1 to {}", j,
-                                              model_.dof()));
+      throw std::invalid_argument(
+          fmt::format("joint {}: the robot has joints 1 to {}", j, model_.dof()));
     }
     return static_cast<std::size_t>(j - 1);
   }

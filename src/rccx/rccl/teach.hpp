@@ -36,8 +36,8 @@ struct TeachIo {
 };
 
 struct Taught {
-  math::Transform t6;  ///< m, rad
-  kin::JointVector q;  ///< rad / m
+  math::Transform t6;         ///< m, rad
+  kin::JointVector q;         ///< rad / m
   bool ended_by_exit = true;  ///< false: the input ran out before `e`
 };
 
