@@ -1,5 +1,5 @@
-// Ctrl-C during a control session (thesis 4.5.2, `user_hangup`). The SIGINT handler only
-// counts and posts a semaphore (both async-signal-safe); the communication task sees the count
+// Ctrl-C (or SIGTERM) during a control session (thesis 4.5.2, `user_hangup`). The handler of
+// rccx::io::signals only counts and posts a semaphore; the communication task sees the count
 // change at its next tick and ends the session with `user_interrupt`, unless the session has a
 // hang-up handler of the user's, which a watcher thread then runs (never the sample loop).
 #pragma once
@@ -12,7 +12,7 @@ class Session;
 
 namespace rccx::rtc::detail {
 
-/// How many SIGINTs have arrived while a handler was installed.
+/// How many SIGINT / SIGTERM have arrived while a handler was installed.
 std::uint32_t hangup_count() noexcept;
 /// A session starting control: installs the handler on first use.
 void register_for_hangup(Session* s);

@@ -397,18 +397,31 @@ void Session::step_simulated_sample() {
 }
 
 Termination Session::wait_for(std::chrono::nanoseconds d) {
+  // A stop signal (Ctrl-C, SIGTERM) ends the wait within a period, whatever its length.
+  const std::uint32_t stops = detail::hangup_count();
+  const auto stopped = [&] { return detail::hangup_count() != stops; };
   if (options_.clock == ClockKind::simulated) {
     const std::int64_t until = shared_->simulated_now_ns.load() + d.count();
-    while (shared_->simulated_now_ns.load() + period_.count() <= until) step_simulated_sample();
+    while (!stopped() && shared_->simulated_now_ns.load() + period_.count() <= until) {
+      step_simulated_sample();
+    }
+    // One more sample lets the communication task see the signal and end control.
+    if (stopped() && controlling()) step_simulated_sample();
   } else {
-    detail::sleep_until(monotonic_ns() + d.count());
+    const std::int64_t until = monotonic_ns() + d.count();
+    for (std::int64_t now = monotonic_ns(); now < until && !stopped(); now = monotonic_ns()) {
+      detail::sleep_until(std::min(until, now + period_.count()));
+    }
   }
   return termination();
 }
 
 Termination Session::wait_terminated(std::chrono::nanoseconds timeout) {
   Shared& s = *shared_;
-  const auto ended = [&] { return s.phase.load(std::memory_order_seq_cst) == kEnded; };
+  const std::uint32_t stops = detail::hangup_count();
+  const auto ended = [&] {
+    return s.phase.load(std::memory_order_seq_cst) == kEnded || detail::hangup_count() != stops;
+  };
   if (options_.clock == ClockKind::simulated) {
     const std::int64_t until = s.simulated_now_ns.load() + timeout.count();
     while (!ended() && s.simulated_now_ns.load() + period_.count() <= until)
@@ -418,7 +431,7 @@ Termination Session::wait_terminated(std::chrono::nanoseconds timeout) {
     while (!ended() && monotonic_ns() < deadline) {
       const std::uint32_t seen = s.planning_bell.load();
       if (ended()) break;
-      wait_while(s.planning_bell, seen, deadline);
+      wait_while(s.planning_bell, seen, std::min(deadline, monotonic_ns() + period_.count()));
     }
   }
   return termination();
@@ -429,9 +442,11 @@ bool Session::wait_until(const std::function<bool(const How&)>& done,
   Shared& s = *shared_;
   const bool simulated = options_.clock == ClockKind::simulated;
   const std::int64_t start = simulated ? s.simulated_now_ns.load() : monotonic_ns();
+  const std::uint32_t stops = detail::hangup_count();
   for (;;) {
     if (done(how())) return true;
     if (s.phase.load(std::memory_order_seq_cst) == kEnded) return false;
+    if (detail::hangup_count() != stops) return false;  // Ctrl-C, SIGTERM
     const std::int64_t now = simulated ? s.simulated_now_ns.load() : monotonic_ns();
     if (now - start >= timeout.count()) return false;
     if (simulated) {

@@ -118,7 +118,8 @@ class Session {
   void terminate(TerminateCode code = TerminateCode::user_request) noexcept;
 
   /// Lets `d` of time pass (in simulated time: runs those samples). Returns the termination
-  /// if control ended meanwhile (or before), an empty one otherwise.
+  /// if control ended meanwhile (or before), an empty one otherwise. Every wait function ends
+  /// within a period when SIGINT or SIGTERM arrives (rccx::io::stop_count() changes).
   Termination wait_for(std::chrono::nanoseconds d);
   /// Waits until control ends or `timeout` passes; returns the termination (code none on
   /// timeout).

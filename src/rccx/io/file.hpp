@@ -1,0 +1,59 @@
+// Files that are replaced whole or not at all, and writes that never lose an error.
+//
+// write_file_atomically() (and AtomicFile for content written in pieces) writes to a temporary
+// file in the target's directory, flushes and fsyncs it, renames it over the target and fsyncs
+// the directory: a reader, a crash or a full disk sees the old file or the new one, never a
+// part. A write that fails (ENOSPC, EIO, a read-only directory) throws FileError, removes the
+// temporary file and leaves the target as it was.
+#pragma once
+
+#include <cstddef>
+#include <filesystem>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+
+namespace rccx::io {
+
+/// A file that could not be read or written; the message names it and the system's reason.
+class FileError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// Writes all of `data` to `fd`, retrying partial writes and EINTR. Returns 0, or the errno
+/// of the failure. Never throws; async-signal-safe.
+int write_all(int fd, const char* data, std::size_t size) noexcept;
+
+class AtomicFile {
+ public:
+  /// Creates the temporary file beside `target` (throws FileError when it cannot).
+  explicit AtomicFile(std::filesystem::path target);
+  /// Removes the temporary file unless committed: the target is untouched.
+  ~AtomicFile();
+  AtomicFile(const AtomicFile&) = delete;
+  AtomicFile& operator=(const AtomicFile&) = delete;
+
+  /// Appends; throws FileError on a failed write.
+  void write(std::string_view data);
+  /// fsync, rename over the target, fsync the directory; throws FileError.
+  void commit();
+  [[nodiscard]] const std::filesystem::path& target() const noexcept { return target_; }
+
+ private:
+  void fail(const char* doing, int error);
+
+  std::filesystem::path target_;
+  std::filesystem::path temporary_;
+  int fd_ = -1;
+  bool committed_ = false;
+};
+
+/// The whole of `data` as the new content of `target`, atomically (see above).
+void write_file_atomically(const std::filesystem::path& target, std::string_view data);
+
+/// The whole content of a regular file; FileError for a directory, a missing or unreadable file,
+/// or one larger than `max_bytes`.
+std::string read_file(const std::filesystem::path& file, std::size_t max_bytes = 64u << 20);
+
+}  // namespace rccx::io

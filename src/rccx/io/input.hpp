@@ -1,0 +1,37 @@
+// Lines from a file descriptor (a terminal, a pipe) that give up when a stop signal arrives:
+// std::getline on std::cin would sit in read(2) through Ctrl-C, since SA_RESTART restarts it.
+// StopAwareInput is a std::streambuf, so a console keeps reading with std::istream.
+//
+//   io::StopAwareInput buffer(STDIN_FILENO);
+//   std::istream in(&buffer);
+//   while (std::getline(in, line)) ...      // ends at end of input or on SIGINT / SIGTERM
+//   if (buffer.stopped()) ...                // and says which
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <streambuf>
+
+namespace rccx::io {
+
+class StopAwareInput : public std::streambuf {
+ public:
+  /// Reads `fd`; stops at the first stop signal after construction.
+  explicit StopAwareInput(int fd) noexcept;
+  /// True when reading ended because of SIGINT / SIGTERM.
+  [[nodiscard]] bool stopped() const noexcept { return stopped_; }
+  /// True when reading ended because of a read error (not end of input).
+  [[nodiscard]] int error() const noexcept { return error_; }
+
+ protected:
+  int_type underflow() override;
+
+ private:
+  int fd_;
+  std::uint32_t stops_at_start_;
+  bool stopped_ = false;
+  int error_ = 0;
+  std::array<char, 4096> buffer_{};
+};
+
+}  // namespace rccx::io

@@ -1,0 +1,32 @@
+// SIGINT and SIGTERM as requests to stop, for the whole process. The handler only counts, keeps
+// the signal's number and posts a semaphore (all async-signal-safe); it is installed with
+// SA_RESTART, so a system call it interrupts is restarted rather than failing. Whoever waits
+// (a session's wait functions, a console reading its input, a long import) looks at
+// stop_count() and ends cleanly within its own period.
+//
+// Programs (the rccx commands) install the handlers for their whole run; a library user's
+// program gets them from rtc::Session only while it is in control (thesis 4.5.2, user_hangup).
+#pragma once
+
+#include <cstdint>
+
+namespace rccx::io {
+
+/// Installs the counting handler for SIGINT and SIGTERM; the dispositions it replaced are
+/// returned by restore_stop_handlers(). Safe to call again (nesting is counted).
+void install_stop_handlers() noexcept;
+/// Undoes one install_stop_handlers(); the last one restores the earlier dispositions.
+void restore_stop_handlers() noexcept;
+
+/// How many SIGINT / SIGTERM have arrived while the handler was installed.
+std::uint32_t stop_count() noexcept;
+/// The number of the last such signal (SIGINT or SIGTERM), 0 before the first.
+int last_stop_signal() noexcept;
+/// The exit status a shell gives a program ended by that signal: 128 + its number (130, 143).
+int stop_exit_code() noexcept;
+
+/// Blocks until a stop signal arrives or wake_stop_waiter() is called (for one watcher thread).
+void wait_stop_signal() noexcept;
+void wake_stop_waiter() noexcept;
+
+}  // namespace rccx::io
