@@ -5,8 +5,11 @@ RELEASE_DIR := build/release
 CMAKE ?= cmake
 
 TSAN_DIR := build/tsan
+FUZZ_DIR := build/fuzz
+# Seconds all fuzz targets get together in `make test` (scripts/fuzz shares them out).
+FUZZ_SECONDS ?= 60
 
-.PHONY: all deps demo test tsan bench build-debug build-release format format-check clean
+.PHONY: all deps demo test unit-tests fuzz tsan bench build-debug build-release format format-check clean
 
 all: build-release
 
@@ -29,9 +32,19 @@ build-release: deps $(RELEASE_DIR)/CMakeCache.txt
 demo: build-release
 	$(RELEASE_DIR)/examples/04_washer
 
-# Debug build with AddressSanitizer and UndefinedBehaviorSanitizer, then every test.
-test: build-debug
+# Debug build with AddressSanitizer and UndefinedBehaviorSanitizer, every test, then the
+# fuzz targets for FUZZ_SECONDS in all.
+test: unit-tests fuzz
+
+unit-tests: build-debug
 	cd $(DEBUG_DIR) && ctest --output-on-failure -j$(JOBS)
+
+# libFuzzer targets of every parser of outside input (clang), each on its corpus in fuzz/corpus.
+fuzz: deps
+	CC=clang CXX=clang++ $(CMAKE) -S . -B $(FUZZ_DIR) -DCMAKE_BUILD_TYPE=Debug -DRCCX_FUZZ=ON \
+	  -DRCCX_BUILD_TESTS=OFF -DRCCX_BUILD_BENCHMARKS=OFF
+	$(CMAKE) --build $(FUZZ_DIR) -j$(JOBS) --target fuzz_targets
+	scripts/fuzz --build $(FUZZ_DIR) --seconds $(FUZZ_SECONDS)
 
 # The threaded parts (RTC sessions) under ThreadSanitizer.
 tsan: deps
