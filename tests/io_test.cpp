@@ -25,8 +25,9 @@ TEST(Parse, NumbersAreWholeFiniteAndInRange) {
   EXPECT_EQ(parse_number("1e-3", "x"), 1e-3);
   EXPECT_EQ(parse_number(".5", "x"), 0.5);
   EXPECT_EQ(parse_number("1e-400", "x"), 0.0);  // underflow is harmless
-  for (const char* bad : {"", " 5", "5 ", "5abc", "abc", "inf", "-inf", "nan", "NaN", "1e400",
-                          "-1e400", "0x10", "--5", "+-5", "5,", "1.2.3", "e5", "+", "-", "."}) {
+  for (const char* bad :
+       {"",       " 5",   "5 ",  "5abc", "abc", "inf",   "-inf", "nan", "NaN", "1e400",
+        "-1e400", "0x10", "--5", "+-5",  "5,",  "1.2.3", "e5",   "+",   "-",   "."}) {
     EXPECT_THROW(parse_number(bad, "x"), ParseError) << bad;
   }
   EXPECT_THROW(parse_number("11", "x", {0, 10, "mm"}), ParseError);
@@ -148,8 +149,8 @@ TEST_F(FileTest, ErrorsNameTheFileAndChangeNothing) {
     EXPECT_NE(std::string(e.what()).find("directory"), std::string::npos) << e.what();
   }
   if (::geteuid() != 0) {  // root writes anywhere
-    std::filesystem::permissions(dir_, std::filesystem::perms::owner_read |
-                                           std::filesystem::perms::owner_exec);
+    std::filesystem::permissions(
+        dir_, std::filesystem::perms::owner_read | std::filesystem::perms::owner_exec);
     EXPECT_THROW(write_file_atomically(dir_ / "f", "x"), FileError);
   }
 }

@@ -8,11 +8,15 @@
 #include <memory>
 #include <string>
 
+#include "rccx/io/console.hpp"
+#include "rccx/io/file.hpp"
+#include "rccx/io/parse.hpp"
 #include "rccx/kinematics/kinematics.hpp"
 
 namespace rccx::tools {
 
-/// Exit codes shared by the rccx subcommands.
+/// Exit codes shared by the rccx subcommands (docs/RELIABILITY.md). A command ended by SIGINT
+/// or SIGTERM exits with 128 + the signal's number (130, 143), as a shell reports it.
 enum ExitCode : int { kOk = 0, kFailure = 1, kBadArguments = 2, kUnreachable = 3 };
 
 /// A bad argument found after parsing: its message goes to stderr and rccx exits with 2.
@@ -60,14 +64,21 @@ inline std::string database_file(const std::string& given) {
   return "rccx.db";
 }
 
-/// Runs a subcommand, turning a BadArgument into its message and exit code 2.
+/// Runs a subcommand: bad input (BadArgument, io::ParseError) gives its message and exit code
+/// 2, a file that cannot be read or written exit code 1.
 template <typename F>
 void guarded(int& exit_code, F&& run) {
   try {
     exit_code = run();
   } catch (const BadArgument& e) {
-    fmt::print(stderr, "error: {}\n", e.message);
+    io::eprint("error: {}\n", e.message);
     exit_code = kBadArguments;
+  } catch (const io::ParseError& e) {
+    io::eprint("error: {}\n", e.what());
+    exit_code = kBadArguments;
+  } catch (const io::FileError& e) {
+    io::eprint("error: {}\n", e.what());
+    exit_code = kFailure;
   }
 }
 

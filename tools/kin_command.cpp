@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "rccx/io/console.hpp"
+#include "rccx/io/parse.hpp"
 #include "rccx/kinematics/kinematics.hpp"
 #include "rccx/math/units.hpp"
 
@@ -23,19 +25,30 @@ std::string unit_of(const kin::Joint& j) {
   return j.type == kin::JointType::revolute ? "rad" : "m";
 }
 
-/// Joint values given by the user, in rad/m, or in deg/m when `degrees` is set.
-kin::JointVector joints_from(const std::vector<double>& values, const kin::Kinematics& k,
-                             bool degrees, const char* what) {
+/// Joint values given by the user (each token strict: whole, finite), in rad/m, or in deg/m
+/// when `degrees` is set. With `within_limits` each must lie within its joint's limits.
+kin::JointVector joints_from(const std::vector<std::string>& values, const kin::Kinematics& k,
+                             bool degrees, const char* what, bool within_limits = false) {
   if (values.size() != k.dof()) {
     throw BadArgument{fmt::format("{}: robot {} has {} joints, got {} values", what, k.model().name,
                                   k.dof(), values.size())};
   }
   kin::JointVector q(k.dof());
   for (std::size_t i = 0; i < k.dof(); ++i) {
-    if (!std::isfinite(values[i]))
-      throw BadArgument{fmt::format("{}: value {} is not finite", what, i + 1)};
-    const bool revolute = k.model().joints[i].type == kin::JointType::revolute;
-    q[i] = degrees && revolute ? math::deg_to_rad(values[i]) : values[i];
+    const kin::Joint& j = k.model().joints[i];
+    const bool revolute = j.type == kin::JointType::revolute;
+    const bool deg = degrees && revolute;
+    const std::string name = fmt::format("{} (joint {})", what, i + 1);
+    // Beyond a few turns (or a kilometre) a value is a typo, not a pose.
+    const double big = deg ? 3600.0 : (revolute ? 20 * math::kPi : 1e3);
+    const std::string unit = deg ? "deg" : unit_of(j);  // outlives the Range's view of it
+    io::Range range{-big, big, unit};
+    if (within_limits) {
+      range.lo = deg ? math::rad_to_deg(j.lower) : j.lower;
+      range.hi = deg ? math::rad_to_deg(j.upper) : j.upper;
+    }
+    const double v = io::parse_number(values[i], name, range);
+    q[i] = deg ? math::deg_to_rad(v) : v;
   }
   return q;
 }
@@ -44,8 +57,8 @@ void warn_outside_limits(const kin::Kinematics& k, const kin::JointVector& q) {
   for (std::size_t i = 0; i < k.dof(); ++i) {
     const kin::Joint& j = k.model().joints[i];
     if (q[i] < j.lower || q[i] > j.upper) {
-      fmt::print(stderr, "warning: joint {} ({}) = {} {} is outside its limits [{}, {}]\n", i + 1,
-                 j.name, q[i], unit_of(j), j.lower, j.upper);
+      io::eprint("warning: joint {} ({}) = {} {} is outside its limits [{}, {}]\n", i + 1, j.name,
+                 q[i], unit_of(j), j.lower, j.upper);
     }
   }
 }
@@ -78,7 +91,7 @@ std::string format_transform(const math::Transform& T) {
 
 struct FkArgs {
   RobotChoice robot{"puma560"};
-  std::vector<double> q;
+  std::vector<std::string> q;
   bool degrees = false;
   bool json = false;
 };
@@ -106,24 +119,19 @@ int run_fk(const FkArgs& args) {
 
 struct IkArgs {
   RobotChoice robot{"puma560"};
-  std::vector<double> T;
+  std::string T;
   std::string config;
-  std::vector<double> near;
+  std::string near;
   bool degrees = false;
   bool all = false;
   bool json = false;
 };
 
-math::Transform pose_from(const std::vector<double>& values) {
-  if (values.size() != 12) {
-    throw BadArgument{
-        fmt::format("--T takes 12 numbers (r11,r12,r13,px,...,r33,pz), got {}", values.size())};
-  }
+math::Transform pose_from(const std::string& text) {
+  const std::vector<double> values =
+      io::parse_number_list(text, "--T", 12, {-1e6, 1e6, "(rotation) or m (position)"});
   std::array<double, 12> m{};
-  for (std::size_t i = 0; i < 12; ++i) {
-    if (!std::isfinite(values[i])) throw BadArgument{"--T: every number must be finite"};
-    m[i] = values[i];
-  }
+  std::copy(values.begin(), values.end(), m.begin());
   const math::Transform T = math::Transform::from_rows(m);
   // RᵀR must be the identity: a pose with a sheared or scaled rotation has no joint solution.
   const math::Rot3 RtR = T.R.transposed() * T.R;
@@ -160,7 +168,18 @@ int run_ik(const IkArgs& args) {
                                     k->model().name, args.config, list)};
     }
   }
-  if (!args.near.empty()) options.near = joints_from(args.near, *k, args.degrees, "--near");
+  if (!args.near.empty()) {
+    std::vector<std::string> near;
+    std::size_t start = 0;
+    for (;;) {
+      const std::size_t comma = args.near.find(',', start);
+      near.push_back(args.near.substr(start, comma - start));
+      if (comma == std::string::npos) break;
+      start = comma + 1;
+    }
+    // The joints to stay near: a pose of the arm, so within its limits.
+    options.near = joints_from(near, *k, args.degrees, "--near", true);
+  }
 
   const bool named = !k->configuration_names().empty();
   auto config_name = [&](const kin::IkResult& r) {
@@ -168,7 +187,7 @@ int run_ik(const IkArgs& args) {
   };
   auto report_singularity = [&](const kin::IkResult& r) {
     if (r.singularity != kin::Singularity::none) {
-      fmt::print(stderr, "note: {} singularity; a joint left free by it was taken from {}\n",
+      io::eprint("note: {} singularity; a joint left free by it was taken from {}\n",
                  kin::to_string(r.singularity), options.near ? "--near" : "the ready pose");
     }
   };
@@ -184,7 +203,7 @@ int run_ik(const IkArgs& args) {
       all.count = kept;
     }
     if (all.count == 0) {
-      fmt::print(stderr, "{}: {}\n", k->model().name, kin::describe(all.status));
+      io::eprint("{}: {}\n", k->model().name, kin::describe(all.status));
       return kUnreachable;
     }
     if (args.json) {
@@ -206,7 +225,7 @@ int run_ik(const IkArgs& args) {
 
   const kin::IkResult r = k->inverse(pose, options);
   if (!r) {
-    fmt::print(stderr, "{}: {}\n", k->model().name, kin::describe(r.status));
+    io::eprint("{}: {}\n", k->model().name, kin::describe(r.status));
     return kUnreachable;
   }
   report_singularity(r);
@@ -297,19 +316,15 @@ void add_kin_command(CLI::App& app, int& exit_code) {
       ->add_option("--T", ik->T,
                    "Pose as 12 comma-separated numbers, row by row: r11,r12,r13,px,r21,r22,r23,py,"
                    "r31,r32,r33,pz (r: rotation matrix, p: position in m)")
-      ->delimiter(',')
       ->required();
   CLI::Option* config_opt = ik_cmd->add_option(
       "--config", ik->config,
       "Configuration to solve for: PUMA l|r (arm) u|d (elbow) n|f (wrist), e.g. lun; Microbo n|f "
       "(wrist)");
-  CLI::Option* near_opt =
-      ik_cmd
-          ->add_option(
-              "--near", ik->near,
-              "Comma-separated joint values (rad or m; with --deg, deg or m) to stay closest to; "
-              "default: the robot's ready pose")
-          ->delimiter(',');
+  CLI::Option* near_opt = ik_cmd->add_option(
+      "--near", ik->near,
+      "Comma-separated joint values (rad or m; with --deg, deg or m) to stay closest to; "
+      "default: the robot's ready pose; within the joint limits");
   config_opt->excludes(near_opt);
   ik_cmd->add_flag("--all", ik->all, "Print every configuration's solution within limits");
   ik_cmd->add_flag("--deg", ik->degrees, "--near is in degrees for revolute joints");

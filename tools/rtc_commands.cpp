@@ -19,6 +19,9 @@
 
 #include "rccx/hw/rcu.hpp"
 #include "rccx/hw/simulated_arm.hpp"
+#include "rccx/io/console.hpp"
+#include "rccx/io/parse.hpp"
+#include "rccx/io/signals.hpp"
 #include "rccx/math/units.hpp"
 #include "rccx/rtc/microbo_driver.hpp"
 #include "rccx/rtc/servo_driver.hpp"
@@ -37,29 +40,24 @@ std::chrono::nanoseconds to_ns(double seconds) {
 }
 
 /// "1ms", "250us", "0.028s"; a bare number is in ms.
-std::chrono::nanoseconds parse_period(const std::string& text) {
-  std::size_t used = 0;
-  double value = 0;
+std::chrono::nanoseconds parse_period(const std::string& text, const char* what = "--period") {
   try {
-    value = std::stod(text, &used);
-  } catch (const std::exception&) {
-    used = 0;
+    return io::parse_duration(text, what, io::BareUnit::milliseconds, rtc::kMinPeriod,
+                              rtc::kMaxPeriod);
+  } catch (const io::ParseError& e) {
+    throw BadArgument{fmt::format("{} (the range RTC serves)", e.what())};
   }
-  const std::string unit = text.substr(used);
-  double scale = 0;
-  if (unit.empty() || unit == "ms") scale = 1e-3;
-  if (unit == "us") scale = 1e-6;
-  if (unit == "s") scale = 1.0;
-  if (used == 0 || scale == 0 || !(value > 0)) {
-    throw BadArgument{
-        fmt::format("--period: \"{}\" is not a duration; write e.g. 1ms, 250us or 0.028s", text)};
+}
+
+/// The longest a control program runs or waits: beyond it a number is a typo (11.6 days).
+constexpr double kMaxRunSeconds = 1e6;
+
+double seconds_of(const std::string& text, const char* what, double lo_s = 1e-6) {
+  try {
+    return io::parse_seconds(text, what, lo_s, kMaxRunSeconds);
+  } catch (const io::ParseError& e) {
+    throw BadArgument{e.what()};
   }
-  const auto p = to_ns(value * scale);
-  if (p < rtc::kMinPeriod || p > rtc::kMaxPeriod) {
-    throw BadArgument{
-        fmt::format("--period: {} is outside the range RTC serves, 0.25 ms to 56 ms", text)};
-  }
-  return p;
 }
 
 /// What every control program takes.
@@ -99,12 +97,16 @@ struct SimulatedRobot : rtc::SimulatedRobot {
     if (!a.period.empty()) o.period = parse_period(a.period);
     o.log = a.log;
     const std::string name = model.name;
+    const bool log_given = !a.log.empty();
     try {
       return rtc::SimulatedRobot(std::move(model), o);
     } catch (const rtc::SessionError& e) {
       throw BadArgument{fmt::format("--period: {}", e.what())};
     } catch (const rtc::LogError& e) {
-      throw BadArgument{fmt::format("--log: {}", e.what())};
+      // RCCX_LOG's errors name it; --log's are named here.
+      const bool environment = std::string_view(e.what()).starts_with("RCCX_LOG");
+      throw BadArgument{environment || !log_given ? std::string(e.what())
+                                                  : fmt::format("--log {}: {}", a.log, e.what())};
     } catch (const std::invalid_argument& e) {
       throw BadArgument{fmt::format("robot {} cannot be simulated: {}", name, e.what())};
     }
@@ -155,24 +157,46 @@ int report_termination(const rtc::Termination& t) {
   return kFailure;
 }
 
+/// The end of every control program: the session closed, the logs in place. A log that is not
+/// complete (a full disk, rows dropped) makes the run a failure; a stop signal gives 128 + it.
+int finish(SimulatedRobot& r, int code) {
+  const std::string problem = r.finish();
+  if (!problem.empty() && code == kOk) code = kFailure;
+  if (io::stop_count() > 0) code = io::stop_exit_code();
+  return code;
+}
+
 // ---------------------------------------------------------------------------------------------
 
 struct ReportArgs : RtcArgs {
-  double seconds = 2.0;
-  double every = 0.5;
+  std::string seconds = "2";
+  std::string every = "0.5";
   bool json = false;
 };
 
+/// --every: at least one sample period, else time would never advance between reports.
+double every_of(const std::string& text, const SimulatedRobot& r) {
+  const double every = seconds_of(text, "--every");
+  if (every < r.period_s()) {
+    throw BadArgument{fmt::format(
+        "--every: \"{}\" is shorter than the sample period ({:g} ms); give at least {:g}ms", text,
+        r.period_s() * 1e3, r.period_s() * 1e3)};
+  }
+  return every;
+}
+
 int run_report(const ReportArgs& a) {
-  if (!(a.seconds > 0) || !(a.every > 0)) throw BadArgument{"--seconds and --every must be > 0"};
+  const double seconds = seconds_of(a.seconds, "--seconds");
+  seconds_of(a.every, "--every");  // its form, before the robot is made
   SimulatedRobot r(a);
+  const double every = every_of(a.every, r);
   r.session->control({}, {});  // empty f1 and f2: the full cycle, nothing commanded
-  const std::int64_t lines = std::max<std::int64_t>(1, std::llround(a.seconds / a.every));
+  const std::int64_t lines = std::max<std::int64_t>(1, std::llround(seconds / every));
   // In real time an overrun says the machine missed a deadline: count it and go on measuring.
   std::uint64_t overruns = 0;
   rtc::Termination t;
-  for (std::int64_t i = 0; i < lines && !t.ended(); ++i) {
-    t = r.session->wait_for(to_ns(a.every));
+  for (std::int64_t i = 0; i < lines && !t.ended() && io::stop_count() == 0; ++i) {
+    t = r.session->wait_for(to_ns(every));
     if (!a.json) print_positions(r.model, r.session->how());
     if (a.realtime && t.code == rtc::TerminateCode::overrun) {
       ++overruns;
@@ -187,7 +211,7 @@ int run_report(const ReportArgs& a) {
     const rtc::LatencyStats s = r.session->latency();
     if (a.json) {
       nlohmann::ordered_json j{{"period_us", Seconds(r.session->period()).count() * 1e6},
-                               {"seconds", a.seconds},
+                               {"seconds", seconds},
                                {"wakeups", s.wakeups},
                                {"missed_deadlines", s.missed_deadlines},
                                {"p50_us", s.p50_us},
@@ -204,16 +228,17 @@ int run_report(const ReportArgs& a) {
           s.missed_deadlines, overruns);
     }
   }
-  return report_termination(t);
+  return finish(r, report_termination(t));
 }
 
 // ---------------------------------------------------------------------------------------------
 
 struct CalibArgs : RtcArgs {
-  double timeout = 120.0;
+  std::string timeout = "120";
 };
 
 int run_calib(const CalibArgs& a) {
+  const double timeout = seconds_of(a.timeout, "--timeout");
   SimulatedRobot r(a);
   const rtc::How before = r.session->how();
   fmt::print("calibrating the {} joints of {} ({}): each seeks its calibration position\n",
@@ -236,17 +261,18 @@ int run_calib(const CalibArgs& a) {
         }
         return h.all_calibrated;
       },
-      to_ns(a.timeout));
+      to_ns(timeout));
   const rtc::How h = r.session->how();
   const rtc::Termination t = r.session->release();
-  if (t.ended()) return report_termination(t);
+  if (t.ended()) return finish(r, report_termination(t));
   if (!done) {
-    fmt::print(stderr, "error: calibration did not finish within {} s\n", a.timeout);
-    return kFailure;
+    if (io::stop_count() == 0)
+      io::eprint("error: calibration did not finish within {} s\n", timeout);
+    return finish(r, kFailure);
   }
   fmt::print("ALL JOINTS calibrated after {:.2f} s\n", h.time_s - before.time_s);
   print_positions_detailed(r.model, h);
-  return kOk;
+  return finish(r, kOk);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -256,21 +282,21 @@ int run_limp(const RtcArgs& a) {
   r.session->control([](rtc::Control& c) { c.chg().power = rtc::Request::off; }, {});
   const bool off = r.session->wait_until([](const rtc::How& h) { return !h.power; }, 1s);
   const rtc::Termination t = r.session->release();
-  if (t.ended()) return report_termination(t);
+  if (t.ended()) return finish(r, report_termination(t));
   if (!off) {
-    fmt::print(stderr, "error: arm power did not go off\n");
-    return kFailure;
+    if (io::stop_count() == 0) io::eprint("error: arm power did not go off\n");
+    return finish(r, kFailure);
   }
   fmt::print("arm power off: the joints are limp (held by their brakes)\n");
   print_positions(r.model, r.session->how());
-  return kOk;
+  return finish(r, kOk);
 }
 
 // ---------------------------------------------------------------------------------------------
 
 struct MarshArgs : RtcArgs {
-  double seconds = 4.0;
-  double every = 0.5;
+  std::string seconds = "4";
+  std::string every = "0.5";
   std::vector<std::string> pushes;
 };
 
@@ -279,53 +305,55 @@ int run_marsh(const MarshArgs& a) {
     std::size_t joint;
     double effort;
   };
+  const double seconds = seconds_of(a.seconds, "--seconds");
+  seconds_of(a.every, "--every");
   SimulatedRobot r(a);
+  const double every = every_of(a.every, r);
   std::vector<Push> pushes;
   for (const std::string& p : a.pushes) {
     const auto colon = p.find(':');
-    std::size_t joint = 0;
-    double effort = 0;
+    if (colon == std::string::npos) {
+      throw BadArgument{
+          fmt::format("--push: {} should be JOINT:EFFORT, e.g. 3:60 (joint 1..{}, N m or N)",
+                      io::quoted(p), r.model.dof())};
+    }
     try {
-      joint = std::stoul(p.substr(0, colon));
-      effort = std::stod(p.substr(colon + 1));
-    } catch (const std::exception&) {
-      joint = 0;
+      const std::size_t joint =
+          io::parse_joint(p.substr(0, colon), "--push: the joint", r.model.dof());
+      // A hand, not a press: beyond 10 kN m the plant's integration means nothing.
+      const double effort = io::parse_number(p.substr(colon + 1), "--push: the effort",
+                                             {-1e4, 1e4, "N m (revolute) or N (prismatic)"});
+      pushes.push_back({joint, effort});
+    } catch (const io::ParseError& e) {
+      throw BadArgument{e.what()};
     }
-    if (colon == std::string::npos || joint < 1 || joint > r.model.dof() ||
-        !std::isfinite(effort)) {
-      throw BadArgument{fmt::format(
-          "--push: \"{}\" should be JOINT:EFFORT with JOINT 1..{} and EFFORT in N m (revolute) or "
-          "N (prismatic)",
-          p, r.model.dof())};
-    }
-    pushes.push_back({joint - 1, effort});
   }
   if (!pushes.empty() && !r.simulated()) {
     throw BadArgument{"--push needs simulated time (a hand cannot push a real-time simulation)"};
   }
-  if (!(a.seconds > 0) || !(a.every > 0)) throw BadArgument{"--seconds and --every must be > 0"};
 
-  std::atomic<bool> finish{false};
+  std::atomic<bool> leave{false};
   r.session->control(
-      [&finish](rtc::Control& c) {
+      [&leave](rtc::Control& c) {
         c.chg().zero_gravity =
-            finish.load(std::memory_order_relaxed) ? rtc::Request::off : rtc::Request::on;
+            leave.load(std::memory_order_relaxed) ? rtc::Request::off : rtc::Request::on;
       },
       {});
   fmt::print("zero gravity: the joints follow a push and stay where they are left{}\n",
              pushes.empty() ? "" : " (pushing for the first half)");
-  const std::int64_t lines = std::max<std::int64_t>(1, std::llround(a.seconds / a.every));
-  for (std::int64_t i = 0; i < lines; ++i) {
+  const std::int64_t lines = std::max<std::int64_t>(1, std::llround(seconds / every));
+  for (std::int64_t i = 0; i < lines && io::stop_count() == 0; ++i) {
     // Between samples of simulated time the arm is the planning level's to touch.
     const bool pushing = 2 * i < lines;
     for (const Push& p : pushes) r.push(p.joint, pushing ? p.effort : 0.0);
-    const rtc::Termination t = r.session->wait_for(to_ns(a.every));
+    const rtc::Termination t = r.session->wait_for(to_ns(every));
     print_positions(r.model, r.session->how());
-    if (t.ended()) return report_termination(t);
+    if (t.ended()) return finish(r, report_termination(t));
   }
-  finish = true;
+  for (const Push& p : pushes) r.push(p.joint, 0.0);
+  leave = true;
   r.session->wait_for(r.session->period() * 2);
-  return report_termination(r.session->release());
+  return finish(r, report_termination(r.session->release()));
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -666,8 +694,13 @@ void add_rtc_commands(CLI::App& app, int& exit_code) {
                             "communication task.") +
                     robot_note);
   add_rtc_options(*report_cmd, *report);
-  report_cmd->add_option("--seconds", report->seconds, "How long to run, s")->capture_default_str();
-  report_cmd->add_option("--every", report->every, "Seconds between reports")
+  report_cmd
+      ->add_option("--seconds", report->seconds,
+                   "How long to run: s, or with a unit (500ms); up to 1e6 s")
+      ->capture_default_str();
+  report_cmd
+      ->add_option("--every", report->every,
+                   "Time between reports: s, or with a unit; at least one sample period")
       ->capture_default_str();
   report_cmd->add_flag("--json", report->json, "Print only the latency figures, as JSON");
   report_cmd->callback(
@@ -679,7 +712,7 @@ void add_rtc_commands(CLI::App& app, int& exit_code) {
       std::string("Calibrate every joint (STOPCAL) and wait for ALL JOINTS (thesis calib.c).") +
           robot_note);
   add_rtc_options(*calib_cmd, *calib);
-  calib_cmd->add_option("--timeout", calib->timeout, "Give up after this long, s")
+  calib_cmd->add_option("--timeout", calib->timeout, "Give up after this long: s, or with a unit")
       ->capture_default_str();
   calib_cmd->callback(
       [calib, &exit_code] { guarded(exit_code, [&] { return run_calib(*calib); }); });
@@ -695,8 +728,14 @@ void add_rtc_commands(CLI::App& app, int& exit_code) {
       "marsh", std::string("Zero gravity: the joints follow a push and stay (thesis marsh.c).") +
                    robot_note);
   add_rtc_options(*marsh_cmd, *marsh);
-  marsh_cmd->add_option("--seconds", marsh->seconds, "How long to run, s")->capture_default_str();
-  marsh_cmd->add_option("--every", marsh->every, "Seconds between reports")->capture_default_str();
+  marsh_cmd
+      ->add_option("--seconds", marsh->seconds,
+                   "How long to run: s, or with a unit (500ms); up to 1e6 s")
+      ->capture_default_str();
+  marsh_cmd
+      ->add_option("--every", marsh->every,
+                   "Time between reports: s, or with a unit; at least one sample period")
+      ->capture_default_str();
   marsh_cmd->add_option("--push", marsh->pushes,
                         "JOINT:EFFORT - a simulated hand pushes joint JOINT (1-based) with EFFORT "
                         "N m or N for the first half of the run; repeatable");

@@ -229,7 +229,7 @@ RcuConfig rcu_config(const kin::RobotModel& model) {
   json doc;
   try {
     doc = json::parse(model.hardware_json, nullptr, true, true);
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {
     throw std::invalid_argument(fmt::format("{}: \"hardware\": {}", model.name, e.what()));
   }
   Reader hardware(doc, fmt::format("{}: \"hardware\"", model.name));

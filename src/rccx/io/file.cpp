@@ -27,7 +27,8 @@ int write_all(int fd, const char* data, std::size_t size) noexcept {
 AtomicFile::AtomicFile(std::filesystem::path target) : target_(std::move(target)) {
   std::error_code ec;
   if (std::filesystem::is_directory(target_, ec)) {
-    throw FileError(fmt::format("cannot write {}: it is a directory; name a file", target_.string()));
+    throw FileError(
+        fmt::format("cannot write {}: it is a directory; name a file", target_.string()));
   }
   const std::filesystem::path dir =
       target_.has_parent_path() ? target_.parent_path() : std::filesystem::path(".");
@@ -114,8 +115,8 @@ std::string read_file(const std::filesystem::path& file, std::size_t max_bytes) 
     out.append(chunk, static_cast<std::size_t>(n));
     if (out.size() > max_bytes) {
       ::close(fd);
-      throw FileError(fmt::format("cannot read {}: larger than {} MiB", file.string(),
-                                  max_bytes >> 20));
+      throw FileError(
+          fmt::format("cannot read {}: larger than {} MiB", file.string(), max_bytes >> 20));
     }
   }
   ::close(fd);

@@ -1,5 +1,6 @@
 // Lines from a file descriptor (a terminal, a pipe) that give up when a stop signal arrives:
-// std::getline on std::cin would sit in read(2) through Ctrl-C, since SA_RESTART restarts it.
+// std::getline on std::cin would sit in read(2) through Ctrl-C when the signal lands on another
+// of the process's threads (a session's), and end the input with an error when it lands here.
 // StopAwareInput is a std::streambuf, so a console keeps reading with std::istream.
 //
 //   io::StopAwareInput buffer(STDIN_FILENO);

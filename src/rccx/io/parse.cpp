@@ -2,8 +2,8 @@
 
 #include <fmt/format.h>
 
-#include <charconv>
 #include <cctype>
+#include <charconv>
 #include <cmath>
 #include <cstdlib>
 #include <system_error>
@@ -32,8 +32,8 @@ double leading_number(std::string_view text, std::size_t& used, bool& overflow) 
     return 0;
   }
   double value = 0;
-  const auto [end, ec] = std::from_chars(body.data(), body.data() + body.size(), value,
-                                         std::chars_format::general);
+  const auto [end, ec] =
+      std::from_chars(body.data(), body.data() + body.size(), value, std::chars_format::general);
   if (end == body.data()) return 0;
   if (ec == std::errc::result_out_of_range) {
     // from_chars leaves `value` alone here: strtod tells overflow (refused) from underflow (0).
@@ -103,9 +103,8 @@ std::int64_t parse_integer(std::string_view text, std::string_view what, std::in
                                  quoted(text), lo, hi));
   }
   if (ec == std::errc::result_out_of_range || value < lo || value > hi) {
-    throw ParseError(
-        fmt::format("{}: {} is out of range; give a whole number from {} to {}", what,
-                    quoted(text), lo, hi));
+    throw ParseError(fmt::format("{}: {} is out of range; give a whole number from {} to {}", what,
+                                 quoted(text), lo, hi));
   }
   return value;
 }
@@ -123,9 +122,8 @@ std::size_t parse_joint(std::string_view text, std::string_view what, std::size_
   return static_cast<std::size_t>(value - 1);
 }
 
-std::chrono::nanoseconds parse_duration(std::string_view text, std::string_view what,
-                                        BareUnit bare, std::chrono::nanoseconds lo,
-                                        std::chrono::nanoseconds hi) {
+std::chrono::nanoseconds parse_duration(std::string_view text, std::string_view what, BareUnit bare,
+                                        std::chrono::nanoseconds lo, std::chrono::nanoseconds hi) {
   if (text.empty()) throw ParseError(fmt::format("{}: a duration is missing", what));
   std::size_t used = 0;
   bool overflow = false;
@@ -138,19 +136,19 @@ std::chrono::nanoseconds parse_duration(std::string_view text, std::string_view 
   if (unit == "us") scale = 1e-6;
   const auto lo_s = std::chrono::duration<double>(lo).count();
   const auto hi_s = std::chrono::duration<double>(hi).count();
-  const std::string range = lo_s >= 1.0 || hi_s >= 100.0
-                                ? range_text(lo_s, hi_s, "s")
-                                : range_text(lo_s * 1e3, hi_s * 1e3, "ms");
+  const std::string range = lo_s >= 1.0 || hi_s >= 100.0 ? range_text(lo_s, hi_s, "s")
+                                                         : range_text(lo_s * 1e3, hi_s * 1e3, "ms");
   if (used == 0 || scale == 0) {
     throw ParseError(fmt::format(
         "{}: {} is not a duration; write a number with s, ms or us (e.g. 2s, 28ms, 250us){}", what,
-        quoted(text), bare == BareUnit::seconds ? "; a bare number is seconds"
-                                                : "; a bare number is milliseconds"));
+        quoted(text),
+        bare == BareUnit::seconds ? "; a bare number is seconds"
+                                  : "; a bare number is milliseconds"));
   }
   const double seconds = value * scale;
   if (overflow || !std::isfinite(seconds) || seconds < lo_s || seconds > hi_s) {
-    throw ParseError(fmt::format("{}: {} is out of range; give a duration {}", what,
-                                 quoted(text), range));
+    throw ParseError(
+        fmt::format("{}: {} is out of range; give a duration {}", what, quoted(text), range));
   }
   return std::chrono::duration_cast<std::chrono::nanoseconds>(
       std::chrono::duration<double>(seconds));
@@ -176,8 +174,8 @@ std::vector<double> parse_number_list(std::string_view text, std::string_view wh
     start = comma + 1;
   }
   if (count != 0 && out.size() != count) {
-    throw ParseError(fmt::format("{}: {} numbers given, {} needed (comma-separated)", what,
-                                 out.size(), count));
+    throw ParseError(
+        fmt::format("{}: {} numbers given, {} needed (comma-separated)", what, out.size(), count));
   }
   return out;
 }
@@ -230,9 +228,8 @@ void check_text(std::string_view text, std::string_view what, std::size_t max_by
   for (const char c : text) {
     const auto u = static_cast<unsigned char>(c);
     if ((u < 0x20 && c != '\t') || u == 0x7f) {
-      throw ParseError(fmt::format(
-          "{}: {} has a control character (\\x{:02x}); use printable text", what, quoted(text),
-          u));
+      throw ParseError(fmt::format("{}: {} has a control character (\\x{:02x}); use printable text",
+                                   what, quoted(text), u));
     }
   }
 }
@@ -246,9 +243,9 @@ void check_name(std::string_view text, std::string_view what, std::size_t max_ch
   for (const char c : text) {
     if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.') ||
         static_cast<unsigned char>(c) >= 0x80) {
-      throw ParseError(fmt::format(
-          "{}: {} is not a name; use letters, digits and _ - . only (no spaces)", what,
-          quoted(text)));
+      throw ParseError(
+          fmt::format("{}: {} is not a name; use letters, digits and _ - . only (no spaces)", what,
+                      quoted(text)));
     }
   }
 }

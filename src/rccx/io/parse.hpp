@@ -50,9 +50,8 @@ enum class BareUnit : std::uint8_t { seconds, milliseconds };
 
 /// A duration: a number and an optional unit, s, ms or us ("2", "2s", "28ms", "250us"); a bare
 /// number is in `bare`. Refused outside [lo, hi].
-std::chrono::nanoseconds parse_duration(std::string_view text, std::string_view what,
-                                        BareUnit bare, std::chrono::nanoseconds lo,
-                                        std::chrono::nanoseconds hi);
+std::chrono::nanoseconds parse_duration(std::string_view text, std::string_view what, BareUnit bare,
+                                        std::chrono::nanoseconds lo, std::chrono::nanoseconds hi);
 
 /// A duration in seconds as a double (see parse_duration), within [lo_s, hi_s].
 double parse_seconds(std::string_view text, std::string_view what, double lo_s, double hi_s);

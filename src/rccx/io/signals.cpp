@@ -41,7 +41,7 @@ void install_stop_handlers() noexcept {
   if (g_installed++ > 0) return;
   struct sigaction sa {};
   sa.sa_handler = on_stop_signal;
-  sa.sa_flags = SA_RESTART;
+  sa.sa_flags = 0;  // no SA_RESTART: a write blocked on a full pipe must not outlive Ctrl-C
   sigemptyset(&sa.sa_mask);
   sigaction(SIGINT, &sa, &g_previous_int);
   sigaction(SIGTERM, &sa, &g_previous_term);

@@ -1,8 +1,10 @@
 // SIGINT and SIGTERM as requests to stop, for the whole process. The handler only counts, keeps
-// the signal's number and posts a semaphore (all async-signal-safe); it is installed with
-// SA_RESTART, so a system call it interrupts is restarted rather than failing. Whoever waits
-// (a session's wait functions, a console reading its input, a long import) looks at
-// stop_count() and ends cleanly within its own period.
+// the signal's number and posts a semaphore (all async-signal-safe). It is installed without
+// SA_RESTART, so that a call blocked on a full pipe or a terminal returns (EINTR) instead of
+// holding the program: rccx's own waits retry EINTR or end cleanly (io::write_all, the
+// futex doorbells, clock_nanosleep, StopAwareInput, SQLite). Whoever waits (a session's wait
+// functions, a console reading its input, a long import) looks at stop_count() and ends
+// cleanly within its own period.
 //
 // Programs (the rccx commands) install the handlers for their whole run; a library user's
 // program gets them from rtc::Session only while it is in control (thesis 4.5.2, user_hangup).

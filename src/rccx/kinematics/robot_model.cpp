@@ -8,6 +8,8 @@
 #include <set>
 #include <sstream>
 
+#include "rccx/io/file.hpp"
+#include "rccx/io/parse.hpp"
 #include "rccx/kinematics/embedded_robots.hpp"
 #include "rccx/math/units.hpp"
 
@@ -94,15 +96,41 @@ class Reader {
     return v.get<std::string>();
   }
 
-  double number(const char* key) {
+  /// A finite number no larger than `limit` in magnitude (every key has a unit: beyond a
+  /// million of it a value is a typo, and would overflow the arithmetic of the solvers).
+  double number(const char* key, double limit = 1e6) {
     const json& v = get(key);
     if (!v.is_number()) fail(fmt::format("\"{}\" must be a number", key));
     const double d = v.get<double>();
     if (!std::isfinite(d)) fail(fmt::format("\"{}\" must be finite", key));
+    if (std::abs(d) > limit)
+      fail(fmt::format("\"{}\" is {:g}; at most {:g} in magnitude", key, d, limit));
     return d;
   }
 
-  double number_or(const char* key, double fallback) { return has(key) ? number(key) : fallback; }
+  std::string name(const char* key) {
+    const std::string n = string(key);
+    try {
+      io::check_name(n, fmt::format("\"{}\"", key), 32);
+    } catch (const io::ParseError& e) {
+      fail(e.what());
+    }
+    return n;
+  }
+
+  std::string text(const char* key) {
+    const std::string t = string(key);
+    try {
+      io::check_text(t, fmt::format("\"{}\"", key), 4096);
+    } catch (const io::ParseError& e) {
+      fail(e.what());
+    }
+    return t;
+  }
+
+  double number_or(const char* key, double fallback, double limit = 1e6) {
+    return has(key) ? number(key, limit) : fallback;
+  }
 
   void no_unknown_keys() const {
     for (const auto& item : object_.items()) {
@@ -155,7 +183,7 @@ JointDynamics parse_dynamics(const json& j, JointType type, const std::string& w
       d.link_com_m[i] = com[i].get<double>();
     }
   }
-  r.has("note");
+  if (r.has("note")) r.text("note");
   r.no_unknown_keys();
   return d;
 }
@@ -163,7 +191,7 @@ JointDynamics parse_dynamics(const json& j, JointType type, const std::string& w
 Joint parse_joint(const json& j, const std::string& where) {
   Reader r(j, where);
   Joint joint;
-  joint.name = r.string("name");
+  joint.name = r.name("name");
   const std::string type = r.string("type");
   if (type == "revolute") {
     joint.type = JointType::revolute;
@@ -172,10 +200,11 @@ Joint parse_joint(const json& j, const std::string& where) {
   } else {
     r.fail(fmt::format("\"type\" is \"{}\"; use \"revolute\" or \"prismatic\"", type));
   }
-  joint.dh.a_m = r.number("a_m");
-  joint.dh.alpha_rad = math::deg_to_rad(r.number("alpha_deg"));
-  joint.dh.d_m = r.number_or("d_m", 0.0);
-  joint.dh.theta_rad = math::deg_to_rad(r.number_or("theta_deg", 0.0));
+  // A link longer than 100 m or an angle of more than a turn is a typo.
+  joint.dh.a_m = r.number("a_m", 100.0);
+  joint.dh.alpha_rad = math::deg_to_rad(r.number("alpha_deg", 360.0));
+  joint.dh.d_m = r.number_or("d_m", 0.0, 100.0);
+  joint.dh.theta_rad = math::deg_to_rad(r.number_or("theta_deg", 0.0, 360.0));
   if (joint.type == JointType::revolute) {
     joint.lower = math::deg_to_rad(r.number("lower_deg"));
     joint.upper = math::deg_to_rad(r.number("upper_deg"));
@@ -194,7 +223,7 @@ Joint parse_joint(const json& j, const std::string& where) {
   if (r.has("dynamics")) {
     joint.dynamics = parse_dynamics(r.get("dynamics"), joint.type, r.where() + ": dynamics");
   }
-  r.has("note");  // free text, for people
+  if (r.has("note")) r.text("note");  // free text, for people
   r.no_unknown_keys();
   if (!(joint.lower < joint.upper)) r.fail("the lower limit must be below the upper limit");
   if (!(joint.resolution_per_count > 0)) r.fail("the encoder resolution must be positive");
@@ -207,18 +236,20 @@ Joint parse_joint(const json& j, const std::string& where) {
 
 }  // namespace
 
-RobotModel parse_robot(std::string_view json_text, std::string_view origin) {
+namespace {
+
+RobotModel parse_robot_json(std::string_view json_text, std::string_view origin) {
   json doc;
   try {
     doc = json::parse(json_text, nullptr, /*allow_exceptions=*/true, /*ignore_comments=*/true);
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {  // syntax, or a number that overflows a double
     throw RobotFileError(fmt::format("{}: not valid JSON: {}", origin, e.what()));
   }
   Reader r(doc, std::string(origin));
   RobotModel model;
-  model.name = r.string("name");
-  model.title = r.string("title");
-  model.source = r.string("source");
+  model.name = r.name("name");
+  model.title = r.text("title");
+  model.source = r.text("source");
   const std::string solver = r.string("solver");
   if (solver == "microbo") {
     model.solver = SolverKind::microbo;
@@ -236,7 +267,10 @@ RobotModel parse_robot(std::string_view json_text, std::string_view origin) {
   for (std::size_t i = 0; i < joints.size(); ++i) {
     model.joints.push_back(parse_joint(joints[i], fmt::format("{}: joint {}", origin, i + 1)));
   }
-  r.has("notes");
+  if (r.has("notes")) {
+    const json& notes = r.get("notes");
+    if (!notes.is_string() && !notes.is_array()) r.fail("\"notes\" must be text or a list of it");
+  }
   if (r.has("hardware")) {
     // What lies below the wire belongs to rccx::hw, which reads it with its own checks.
     const json& hardware = r.get("hardware");
@@ -247,12 +281,24 @@ RobotModel parse_robot(std::string_view json_text, std::string_view origin) {
   return model;
 }
 
+}  // namespace
+
+RobotModel parse_robot(std::string_view json_text, std::string_view origin) {
+  try {
+    return parse_robot_json(json_text, origin);
+  } catch (const json::exception& e) {  // e.g. text that is not UTF-8 met by dump()
+    throw RobotFileError(fmt::format("{}: {}", origin, e.what()));
+  }
+}
+
 RobotModel load_robot_file(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  if (!in) throw RobotFileError(fmt::format("{}: cannot open the robot file", path.string()));
-  std::ostringstream text;
-  text << in.rdbuf();
-  return parse_robot(text.str(), path.string());
+  std::string text;
+  try {
+    text = io::read_file(path, 1U << 20);  // a robot file is a few kB
+  } catch (const io::FileError& e) {
+    throw RobotFileError(fmt::format("{} (the robot file)", e.what()));
+  }
+  return parse_robot(text, path.string());
 }
 
 std::vector<std::string> builtin_robot_names() {

@@ -2,38 +2,66 @@
 
 #include <fmt/format.h>
 
-#include <cerrno>
 #include <chrono>
 #include <cstdlib>
-#include <cstring>
+
+#include "rccx/io/console.hpp"
 
 namespace rccx::rtc {
 
 SampleLog::SampleLog(const std::filesystem::path& file, const kin::RobotModel& model)
-    : path_(file), kinematics_(kin::make_kinematics(model)) {
-  file_ = std::fopen(file.c_str(), "w");
-  if (file_ == nullptr) {
-    throw LogError(fmt::format("cannot write the log {}: {}", file.string(), std::strerror(errno)));
+    : name_(file.string()), path_(file), kinematics_(kin::make_kinematics(model)) {
+  try {
+    file_ = std::make_unique<io::AtomicFile>(file);  // refuses a directory, a missing one
+  } catch (const io::FileError& e) {
+    throw LogError(fmt::format("cannot write the log: {}", e.what()));
   }
+  // The header goes with the first rows: a disk that is full from the start is a write that
+  // fails (said at once, the log not saved), not a bad file name.
   const std::size_t n = model.dof();
   std::string header = "t,seg";
   for (std::size_t i = 1; i <= n; ++i) header += fmt::format(",q{}", i);
   for (std::size_t i = 1; i <= n; ++i) header += fmt::format(",qm{}", i);
   header += ",x,y,z,ax,ay,az\n";
-  std::fputs(header.c_str(), file_);
-  writer_ = std::thread([this] { write_loop(); });
+  writer_ =
+      std::thread([this, header = std::move(header)]() mutable { write_loop(std::move(header)); });
 }
 
 std::unique_ptr<SampleLog> SampleLog::from_environment(const kin::RobotModel& model) {
   const char* file = std::getenv("RCCX_LOG");
   if (file == nullptr || *file == '\0') return nullptr;
-  return std::make_unique<SampleLog>(file, model);
+  try {
+    return std::make_unique<SampleLog>(file, model);
+  } catch (const LogError& e) {
+    throw LogError(fmt::format("RCCX_LOG={}: {} (unset RCCX_LOG or name a file you can write)",
+                               file, e.what()));
+  }
+}
+
+std::string SampleLog::close() {
+  if (closed_) return {};
+  closed_ = true;
+  stop_.store(true);
+  writer_.join();
+  std::string problem = error_;
+  if (problem.empty() && dropped_.load() > 0) {
+    problem = fmt::format("the log {} is missing {} rows the disk could not keep up with", name_,
+                          dropped_.load());
+  }
+  if (problem.empty()) {
+    try {
+      file_->commit();
+    } catch (const io::FileError& e) {
+      problem = fmt::format("the log was not saved: {}", e.what());
+      io::eprint("rccx: {}\n", problem);
+    }
+  }
+  file_.reset();  // not committed: the temporary file goes, the target stays as it was
+  return problem;
 }
 
 SampleLog::~SampleLog() {
-  stop_ = true;
-  writer_.join();
-  std::fclose(file_);
+  (void)close();
 }
 
 bool SampleLog::push(const LogRow& row) noexcept {
@@ -42,28 +70,49 @@ bool SampleLog::push(const LogRow& row) noexcept {
   return false;
 }
 
-void SampleLog::write_loop() {
-  // Drains every few milliseconds: the file sees whole batches, the loop never waits for it.
+void SampleLog::write_loop(std::string pending) {
+  // Drains every few milliseconds: the file sees whole rows in batches, the loop never waits.
+  std::uint64_t dropped_said = 0;
   for (;;) {
     const bool stopping = stop_.load();
     LogRow row;
-    while (queue_.pop(row)) write(row);
+    while (queue_.pop(row)) {
+      format(row, pending);
+      if (pending.size() > (64U << 10)) flush(pending);
+    }
+    flush(pending);
+    if (const std::uint64_t d = dropped_.load(); d > 0 && dropped_said == 0) {
+      dropped_said = d;  // said once, at once; close() gives the total
+      io::eprint("rccx: the log {} cannot keep up: {} rows dropped so far (a slow disk?)\n", name_,
+                 d);
+    }
     if (stopping) break;
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
-  std::fflush(file_);
 }
 
-void SampleLog::write(const LogRow& row) {
-  fmt::memory_buffer line;
-  fmt::format_to(std::back_inserter(line), "{:.6f},{}", row.t_s, row.segment);
-  for (double q : row.commanded) fmt::format_to(std::back_inserter(line), ",{:.9g}", q);
-  for (double q : row.measured) fmt::format_to(std::back_inserter(line), ",{:.9g}", q);
+void SampleLog::format(const LogRow& row, std::string& out) {
+  auto it = std::back_inserter(out);
+  fmt::format_to(it, "{:.6f},{}", row.t_s, row.segment);
+  for (double q : row.commanded) fmt::format_to(it, ",{:.9g}", q);
+  for (double q : row.measured) fmt::format_to(it, ",{:.9g}", q);
   const math::Transform T = kinematics_->forward(row.commanded);
-  fmt::format_to(std::back_inserter(line), ",{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g}\n", T.p.x,
-                 T.p.y, T.p.z, T.R.a.x, T.R.a.y, T.R.a.z);
-  std::fwrite(line.data(), 1, line.size(), file_);
+  fmt::format_to(it, ",{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g}\n", T.p.x, T.p.y, T.p.z, T.R.a.x,
+                 T.R.a.y, T.R.a.z);
   written_.fetch_add(1, std::memory_order_relaxed);
+}
+
+void SampleLog::flush(std::string& pending) {
+  if (pending.empty()) return;
+  if (error_.empty()) {
+    try {
+      file_->write(pending);  // whole rows only: the file always ends on a row boundary
+    } catch (const io::FileError& e) {
+      error_ = fmt::format("the log was not saved: {}", e.what());
+      io::eprint("rccx: {}; control goes on without it\n", error_);
+    }
+  }
+  pending.clear();
 }
 
 }  // namespace rccx::rtc

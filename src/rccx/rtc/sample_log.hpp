@@ -5,17 +5,24 @@
 // robot's forward kinematics. The communication task pushes fixed-size rows into a lock-free
 // queue; a writer thread does the kinematics and the file I/O, so the sample loop never waits
 // on a disk. Rows the writer cannot keep up with are dropped and counted, never blocked on.
+//
+// The file is written whole or not at all (rccx::io::AtomicFile): rows go to a temporary file
+// beside it, in whole rows, and close() renames it over the target. A write that fails (a full
+// disk) or rows dropped are said on stderr at once, and close() returns the problem so that the
+// program's exit code can say the log is not complete; the target is then left as it was.
 #pragma once
 
 #include <atomic>
 #include <boost/lockfree/spsc_queue.hpp>
 #include <cstdint>
-#include <cstdio>
 #include <filesystem>
 #include <memory>
 #include <stdexcept>
 #include <thread>
 
+#include <string>
+
+#include "rccx/io/file.hpp"
 #include "rccx/kinematics/kinematics.hpp"
 
 namespace rccx::rtc {
@@ -35,11 +42,16 @@ struct LogRow {
 
 class SampleLog {
  public:
-  /// Opens (truncates) `file` and writes the header; throws LogError saying why it cannot.
+  /// Starts the log of `file` (written when closed) with its header; throws LogError saying
+  /// why it cannot (a directory, a missing directory, no permission).
   SampleLog(const std::filesystem::path& file, const kin::RobotModel& model);
-  /// The log the environment asks for (RCCX_LOG=FILE), or nullptr.
+  /// The log the environment asks for (RCCX_LOG=FILE), or nullptr; its errors name RCCX_LOG.
   static std::unique_ptr<SampleLog> from_environment(const kin::RobotModel& model);
-  /// Writes what is queued and closes the file.
+  /// Writes what is queued and puts the file in place. Empty when the log is complete, else
+  /// what went wrong (rows dropped, a write that failed: the target is then left as it was).
+  /// Only the first call does anything.
+  std::string close();
+  /// close(), its problem already said on stderr.
   ~SampleLog();
   SampleLog(const SampleLog&) = delete;
   SampleLog& operator=(const SampleLog&) = delete;
@@ -51,13 +63,17 @@ class SampleLog {
   [[nodiscard]] const std::filesystem::path& path() const noexcept { return path_; }
 
  private:
-  void write_loop();
-  void write(const LogRow& row);
+  void write_loop(std::string pending);
+  void format(const LogRow& row, std::string& out);
+  void flush(std::string& pending);
 
+  std::string name_;  ///< how messages name the log: "--log F" or "RCCX_LOG F"
   static constexpr std::size_t kQueue = 4096;  ///< 4 s at 1 kHz before rows are dropped
   std::filesystem::path path_;
   std::unique_ptr<kin::Kinematics> kinematics_;
-  std::FILE* file_ = nullptr;
+  std::unique_ptr<io::AtomicFile> file_;
+  std::string error_;  ///< writer thread's, read after it is joined
+  bool closed_ = false;
   boost::lockfree::spsc_queue<LogRow, boost::lockfree::capacity<kQueue>> queue_;
   std::atomic<bool> stop_{false};
   std::atomic<std::uint64_t> written_{0};

@@ -182,11 +182,7 @@ Session::Session(Driver& driver, SessionOptions options)
   Shared& s = *shared_;
   s.period_ns = period_.count();
   s.t0_ns = monotonic_ns();
-  try {
-    environment_log_ = SampleLog::from_environment(driver_.model());
-  } catch (const LogError& e) {
-    throw SessionError(fmt::format("RCCX_LOG: {}", e.what()));
-  }
+  environment_log_ = SampleLog::from_environment(driver_.model());  // LogError names RCCX_LOG
   s.log = environment_log_.get();
   s.control.session_ = this;
   communication_thread_ = std::thread([this] { communication_task(); });
@@ -239,6 +235,7 @@ void Session::close(bool power_off) {
   communication_thread_.join();
   control_thread_.join();
   closed_ = true;
+  if (environment_log_) log_problem_ = environment_log_->close();
 }
 
 // ---------------------------------------------------------------------------------------------

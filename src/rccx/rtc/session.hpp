@@ -111,8 +111,12 @@ class Session {
   /// rtc_release: stops control (the arm holds) and returns how it ended (`code` none if it
   /// was still running). Control may be started again after it.
   Termination release(bool power_off = false);
-  /// rtc_close: releases and stops both tasks. Called by the destructor.
+  /// rtc_close: releases and stops both tasks, and puts RCCX_LOG's log in place. Called by
+  /// the destructor.
   void close(bool power_off = false);
+  /// After close(): empty when RCCX_LOG's log (if any) is complete, else what went wrong (a
+  /// write that failed, rows dropped), already said on stderr.
+  [[nodiscard]] const std::string& log_problem() const noexcept { return log_problem_; }
 
   /// Ends the session from the planning level (the `terminate` variable).
   void terminate(TerminateCode code = TerminateCode::user_request) noexcept;
@@ -176,6 +180,7 @@ class Session {
   std::unique_ptr<Shared> shared_;
   std::function<void(Session&)> hangup_handler_;
   std::unique_ptr<SampleLog> environment_log_;  ///< RCCX_LOG's, when set
+  std::string log_problem_;
   ControlFunction f1_, f2_;
   std::uint32_t simulated_ticks_ = 0;  ///< planning side: ticks granted in simulated time
   std::thread communication_thread_;

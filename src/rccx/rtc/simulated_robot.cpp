@@ -38,6 +38,15 @@ double SimulatedRobot::period_s() const {
   return std::chrono::duration<double>(session->period()).count();
 }
 
+std::string SimulatedRobot::finish() {
+  session->close();
+  std::string problem = session->log_problem();
+  if (log) {
+    if (std::string p = log->close(); !p.empty()) problem += (problem.empty() ? "" : "; ") + p;
+  }
+  return problem;
+}
+
 void SimulatedRobot::push(std::size_t joint, double effort) {
   if (rcu) {
     rcu->set_external_effort(joint, effort);

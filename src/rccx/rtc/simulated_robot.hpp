@@ -45,6 +45,9 @@ struct SimulatedRobot {
   [[nodiscard]] double period_s() const;
   /// A simulated hand pushes a joint (N m or N); only between samples of simulated time.
   void push(std::size_t joint, double effort);
+  /// Closes the session and puts the logs (--log's and RCCX_LOG's) in place: empty when they
+  /// are complete, else what went wrong (already said on stderr).
+  std::string finish();
 };
 
 }  // namespace rccx::rtc
