@@ -28,11 +28,13 @@ TEST(Teach, MoveAJointExamineAndSaveByName) {
   std::ostringstream out;
   const rccl::Taught t = rccl::teach_loop(arm, {in, out, &db, {}});
   EXPECT_TRUE(t.ended_by_exit);
+  EXPECT_EQ(t.failed_commands, 1U) << out.str();  // "bogus"
+  EXPECT_FALSE(t.ok());
   EXPECT_NEAR(t.q[0], 30_deg, 0.2_deg) << out.str();
   const auto at = out.str().find("joints ");  // xd shows it, in deg
   ASSERT_NE(at, std::string::npos) << out.str();
   EXPECT_NEAR(std::stod(out.str().substr(at + 7)), 30.0, 0.2) << out.str();
-  EXPECT_NE(out.str().find("unknown command 'bogus'"), std::string::npos) << out.str();
+  EXPECT_NE(out.str().find("unknown command \"bogus\""), std::string::npos) << out.str();
   const auto saved = db.get("puma560", "PICK");
   ASSERT_TRUE(saved);
   EXPECT_LT((saved->value.p - t.t6.p).norm(), 1e-3);
