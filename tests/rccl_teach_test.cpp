@@ -28,11 +28,13 @@ TEST(Teach, MoveAJointExamineAndSaveByName) {
   std::ostringstream out;
   const rccl::Taught t = rccl::teach_loop(arm, {in, out, &db, {}});
   EXPECT_TRUE(t.ended_by_exit);
+  EXPECT_EQ(t.failed_commands, 1U) << out.str();  // "bogus"
+  EXPECT_FALSE(t.ok());
   EXPECT_NEAR(t.q[0], 30_deg, 0.2_deg) << out.str();
   const auto at = out.str().find("joints ");  // xd shows it, in deg
   ASSERT_NE(at, std::string::npos) << out.str();
   EXPECT_NEAR(std::stod(out.str().substr(at + 7)), 30.0, 0.2) << out.str();
-  EXPECT_NE(out.str().find("unknown command 'bogus'"), std::string::npos) << out.str();
+  EXPECT_NE(out.str().find("unknown command \"bogus\""), std::string::npos) << out.str();
   const auto saved = db.get("puma560", "PICK");
   ASSERT_TRUE(saved);
   EXPECT_LT((saved->value.p - t.t6.p).norm(), 1e-3);
@@ -111,6 +113,91 @@ TEST(Teach, ExamineMotorParametersOnTheMicrobo) {
   (void)rccl::teach_loop(arm, {in, out, nullptr, {}});
   // Joint 2's parameters as robots/microbo.json gives them: proportional gain 100 first.
   EXPECT_NE(out.str().find("joint 2 motor parameters: 100 "), std::string::npos) << out.str();
+  EXPECT_FALSE(arm.stop_control().ended());
+}
+
+}  // namespace
+
+namespace {
+
+// A refused line moves nothing: `m 1.5 10` is not joint 1 (nor 1.5 read as 1).
+TEST(Teach, ARefusedLineMovesNothingAndCounts) {
+  rtc::SimulatedRobot robot(kin::builtin_robot("puma560"));
+  rccl::Manipulator arm(*robot.session);
+  arm.start();
+  const kin::JointVector before = robot.session->how().q();
+  std::istringstream in("m 1.5 10\nm 1 10 20\nm 1 1e9\np\ns 1e308\nq\ne\n");
+  std::ostringstream out;
+  const rccl::Taught t = rccl::teach_loop(arm, {in, out, nullptr, {}});
+  EXPECT_TRUE(t.ended_by_exit);
+  EXPECT_EQ(t.failed_commands, 4U) << out.str();
+  EXPECT_FALSE(t.ok());
+  for (std::size_t j = 0; j < 6; ++j) EXPECT_NEAR(t.q[j], before[j], 0.01_deg) << j;
+  EXPECT_NE(out.str().find("\"1.5\" is not a joint"), std::string::npos) << out.str();
+  EXPECT_NE(out.str().find("from 0.001 to 90 deg or mm"), std::string::npos) << out.str();
+  EXPECT_FALSE(t.termination.ended());
+  EXPECT_FALSE(arm.stop_control().ended());
+}
+
+// Control ended by a fault: said at once with the terminate code's meaning; motion refused
+// from then on; the result carries the end.
+TEST(Teach, AFaultEndsControlAndMotionIsRefusedAfterIt) {
+  rtc::SimulatedRobot robot(kin::builtin_robot("puma560"));
+  rccl::Manipulator arm(*robot.session);
+  arm.start();
+  const double q1 = robot.session->how().q()[0];
+  std::istringstream in("push 2 1 0.1\nm 1 30\nh\nZ\ne\n");
+  std::ostringstream out;
+  // The "hand" injects a joint fault instead of pushing.
+  const rccl::Taught t =
+      rccl::teach_loop(arm, {in, out, nullptr, [&](std::size_t, double effort) {
+                               if (effort != 0.0)
+                                 robot.session->terminate(rtc::TerminateCode::joint_fault);
+                             }});
+  EXPECT_TRUE(t.termination.ended());
+  EXPECT_EQ(t.termination.code, rtc::TerminateCode::joint_fault);
+  EXPECT_FALSE(t.ok());
+  EXPECT_EQ(t.failed_commands, 3U) << out.str();  // m, h, Z
+  EXPECT_NEAR(t.q[0], q1, 0.01_deg) << out.str();
+  const std::string said = out.str();
+  EXPECT_NE(said.find("control has ended (joint_fault"), std::string::npos) << said;
+  EXPECT_NE(said.find("motion commands are refused; e exits"), std::string::npos) << said;
+  EXPECT_EQ(said.find("hand open"), std::string::npos) << said;
+  EXPECT_EQ(said.find("the arm holds"), std::string::npos) << said;
+}
+
+// A pose with a joint beyond its limits is not saved: pushed past joint 1's upper limit in zero
+// gravity, the arm ends control (observed_position) and stays there.
+TEST(Teach, SaveRefusesAPoseBeyondTheJointLimits) {
+  TempDb file;
+  rccl::PositionDb db(file.path);
+  rtc::SimulatedRobot robot(kin::builtin_robot("puma560"));
+  rccl::Manipulator arm(*robot.session);
+  arm.start();
+  std::istringstream in("m 1 158\nZ\npush 1 60 0.5\nsave OUT\ne\n");
+  std::ostringstream out;
+  const rccl::Taught t =
+      rccl::teach_loop(arm, {in, out, &db, [&](std::size_t j, double e) { robot.push(j, e); }});
+  ASSERT_GT(t.q[0], kin::builtin_robot("puma560").joints[0].upper) << out.str();
+  EXPECT_NE(out.str().find("beyond its upper limit 160.000 deg; nothing saved"), std::string::npos)
+      << out.str();
+  EXPECT_FALSE(db.get("puma560", "OUT"));
+  EXPECT_TRUE(t.termination.ended());
+}
+
+// A bad name is refused before anything is written.
+TEST(Teach, SaveRefusesABadNameAndExtraWords) {
+  TempDb file;
+  rccl::PositionDb db(file.path);
+  rtc::SimulatedRobot robot(kin::builtin_robot("puma560"));
+  rccl::Manipulator arm(*robot.session);
+  arm.start();
+  std::istringstream in("save PICK UP\nsave P/Q\ne\n");
+  std::ostringstream out;
+  const rccl::Taught t = rccl::teach_loop(arm, {in, out, &db, {}});
+  EXPECT_EQ(t.failed_commands, 2U) << out.str();
+  EXPECT_FALSE(db.get("puma560", "PICK"));
+  EXPECT_TRUE(db.list().empty());
   EXPECT_FALSE(arm.stop_control().ended());
 }
 

@@ -2,101 +2,67 @@
 
 #include <fmt/format.h>
 
-#include <iostream>
-#include <optional>
-#include <sstream>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstring>
+#include <istream>
 #include <string>
 
+#include "console_lines.hpp"
 #include "rccx/hw/rcu.hpp"
+#include "rccx/io/console.hpp"
+#include "rccx/io/input.hpp"
+#include "rccx/io/parse.hpp"
+#include "rccx/io/signals.hpp"
 
 namespace rccx::tools {
 
 namespace {
-
-std::optional<unsigned long> parse_hex(const std::string& word, unsigned long max) {
-  if (word.empty() || word.size() > 6) return std::nullopt;
-  std::size_t used = 0;
-  unsigned long v = 0;
-  try {
-    v = std::stoul(word, &used, 16);
-  } catch (const std::exception&) {
-    return std::nullopt;
-  }
-  if (used != word.size() || v > max) return std::nullopt;
-  return v;
-}
-
-std::optional<hw::RcuFault> parse_fault(const std::string& word) {
-  for (const auto f : {hw::RcuFault::joint_not_answering, hw::RcuFault::encoder_error,
-                       hw::RcuFault::phase_error, hw::RcuFault::power_loss}) {
-    if (word == hw::to_string(f)) return f;
-  }
-  return std::nullopt;
-}
 
 struct RcuArgs {
   RobotChoice robot{"microbo"};
   bool uncalibrated = false;
 };
 
+/// Emulated time in slices, so that Ctrl-C ends a long `step` soon. False when stopped.
+bool advance(hw::Rcu& rcu, std::int64_t us, std::uint32_t stops) {
+  constexpr std::int64_t kSliceUs = 10'000;
+  while (us > 0) {
+    if (io::stop_count() != stops) return false;
+    const std::int64_t slice = std::min(us, kSliceUs);
+    rcu.advance_us(slice);
+    us -= slice;
+  }
+  return true;
+}
+
 /// One console line; false (after one line on stderr) when it cannot be done.
-bool run_line(hw::Rcu& rcu, const std::string& line) {
-  std::istringstream in(line);
-  std::string verb, a, b, extra;
-  in >> verb >> a >> b >> extra;
-  const auto fail = [&](const std::string& why) {
-    fmt::print(stderr, "error: \"{}\": {}\n", line, why);
+bool run_line(hw::Rcu& rcu, const std::string& line, std::uint32_t stops) {
+  RcuLine c;
+  try {
+    c = parse_rcu_line(line, rcu.model().dof());
+  } catch (const io::ParseError& e) {
+    io::eprint("error: {}: {}\n", io::quoted(line), e.what());
     return false;
-  };
-  if (!extra.empty()) return fail("too many words");
-  const auto address = [&](const std::string& w) -> std::optional<std::uint16_t> {
-    const auto v = parse_hex(w, 0xffff);
-    const std::size_t n = rcu.model().dof();
-    if (!v || *v < hw::kRcuBase || *v >= hw::kRcuBase + 2 * n) return std::nullopt;
-    return static_cast<std::uint16_t>(*v);
-  };
-  const std::string registers =
-      fmt::format("{:04X} to {:04X} (hex)", hw::kRcuBase, hw::kRcuBase + 2 * rcu.model().dof() - 1);
-  if (verb == "out") {
-    const auto addr = address(a);
-    const auto value = parse_hex(b, 0xff);
-    if (!addr) return fail("the address must be one of the joints' registers, " + registers);
-    if (!value) return fail("the byte must be 00 to FF (hex)");
-    rcu.out(*addr, static_cast<std::uint8_t>(*value));
-    return true;
   }
-  if (verb == "in") {
-    const auto addr = address(a);
-    if (!addr || !b.empty()) return fail("write: in ADDR, with ADDR one of " + registers);
-    fmt::print("{:02X}\n", rcu.in(*addr));
-    return true;
+  switch (c.kind) {
+    case RcuLine::Kind::none:
+      return true;
+    case RcuLine::Kind::out:
+      rcu.out(c.address, c.byte);
+      return true;
+    case RcuLine::Kind::in:
+      fmt::print("{:02X}\n", rcu.in(c.address));
+      return true;
+    case RcuLine::Kind::step:
+      return advance(rcu, c.step_us, stops);
+    case RcuLine::Kind::fault:
+      rcu.inject(c.fault, c.joint);
+      return true;
   }
-  if (verb == "step") {
-    double ms = 0;
-    try {
-      ms = std::stod(a);
-    } catch (const std::exception&) {
-      ms = -1;
-    }
-    if (!(ms >= 0) || ms > 3.6e6 || !b.empty()) return fail("write: step MS, with MS >= 0");
-    rcu.advance_us(std::llround(ms * 1000));
-    return true;
-  }
-  if (verb == "fault") {
-    const auto joint = parse_hex(a, 8);
-    const auto kind = parse_fault(b);
-    if (!joint || *joint < 1 || *joint > rcu.model().dof()) {
-      return fail(fmt::format("the joint must be 1 to {}", rcu.model().dof()));
-    }
-    if (!kind) {
-      return fail(
-          "the fault must be joint_not_answering, encoder_error, phase_error or "
-          "power_loss");
-    }
-    rcu.inject(*kind, *joint - 1);
-    return true;
-  }
-  return fail("unknown command; use out ADDR BYTE, in ADDR, step MS or fault JOINT KIND");
+  return true;
 }
 
 int run_rcu(const RcuArgs& a) {
@@ -109,11 +75,28 @@ int run_rcu(const RcuArgs& a) {
   } catch (const std::invalid_argument& e) {
     throw BadArgument{fmt::format("robot {} has no RCU to emulate: {}", model.name, e.what())};
   }
+  // Ctrl-C and SIGTERM end the console between lines or within a step, not the process.
+  io::install_stop_handlers();
+  const std::uint32_t stops = io::stop_count();
   int status = kOk;
-  std::string line;
-  while (std::getline(std::cin, line)) {
-    if (line.find_first_not_of(" \t\r") == std::string::npos || line[0] == '#') continue;
-    if (!run_line(*rcu, line)) status = kFailure;
+  {
+    io::StopAwareInput buffer(STDIN_FILENO);
+    std::istream in(&buffer);
+    std::string line;
+    while (io::stop_count() == stops && std::getline(in, line)) {
+      if (!run_line(*rcu, line, stops)) status = kFailure;
+    }
+    if (buffer.error() != 0) {
+      io::eprint("error: reading stdin: {}\n", std::strerror(buffer.error()));
+      status = kFailure;
+    }
+  }
+  std::fflush(stdout);
+  const bool stopped = io::stop_count() != stops;
+  io::restore_stop_handlers();
+  if (stopped) {
+    io::eprint("rccx rcu: stopped by a signal\n");
+    return io::stop_exit_code();
   }
   return status;
 }

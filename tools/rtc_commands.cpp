@@ -1,4 +1,5 @@
 #include "rtc_commands.hpp"
+#include "console_lines.hpp"
 
 #include <fmt/format.h>
 #include <poll.h>
@@ -412,43 +413,16 @@ constexpr const char* kTestMenu =
     "  X       examine the joint's motor parameters\n"
     "  ?       this menu\n";
 
-/// Lines from stdin that give up waiting when `stop` is set (Ctrl-C): std::getline would block
-/// on and on, since the session keeps SIGINT from ending the process.
-class LineReader {
- public:
-  explicit LineReader(const std::atomic<bool>& stop) : stop_(stop) {}
-
-  bool next(std::string& line) {
-    for (;;) {
-      if (const auto nl = buffer_.find('\n'); nl != std::string::npos) {
-        line = buffer_.substr(0, nl);
-        buffer_.erase(0, nl + 1);
-        return true;
-      }
-      if (eof_ || stop_.load()) {
-        if (buffer_.empty() || stop_.load()) return false;
-        line = std::exchange(buffer_, {});
-        return true;
-      }
-      pollfd p{STDIN_FILENO, POLLIN, 0};
-      if (poll(&p, 1, 100) <= 0) continue;  // look at `stop` ten times a second
-      char chunk[4096];
-      const ssize_t n = read(STDIN_FILENO, chunk, sizeof chunk);
-      if (n <= 0) {
-        eof_ = n == 0 || errno != EINTR;
-      } else {
-        buffer_.append(chunk, static_cast<std::size_t>(n));
-      }
-    }
-  }
-
- private:
-  const std::atomic<bool>& stop_;
-  std::string buffer_;
-  bool eof_ = false;
+/// Ctrl-C and SIGTERM end the console cleanly for its whole run, in control or not.
+struct StopHandlers {
+  StopHandlers() noexcept { io::install_stop_handlers(); }
+  ~StopHandlers() { io::restore_stop_handlers(); }
+  StopHandlers(const StopHandlers&) = delete;
+  StopHandlers& operator=(const StopHandlers&) = delete;
 };
 
 int run_jointtest(const RtcArgs& a) {
+  const StopHandlers handlers;
   SimulatedRobot r(a);
   const kin::RobotModel& m = r.model;
   auto queue =
@@ -506,9 +480,10 @@ int run_jointtest(const RtcArgs& a) {
     c.chg().posvel(ramp->joint, ramp->at);
     if (ramp->at == ramp->target) ramp->active = false;
   };
-  // Ctrl-C ends the program (the arm holds); without this it would only end control.
-  std::atomic<bool> interrupted{false};
-  r.session->set_hangup_handler([&interrupted](rtc::Session&) { interrupted = true; });
+  // Ctrl-C ends the program (the arm holds) rather than control: the loop sees the stop count.
+  r.session->set_hangup_handler([](rtc::Session&) {});
+  const std::uint32_t stops = io::stop_count();
+  const auto stopped = [stops] { return io::stop_count() != stops; };
   const auto start = [&] { r.session->control(f1, f2); };
   start();
 
@@ -516,69 +491,75 @@ int run_jointtest(const RtcArgs& a) {
   std::vector<double> velocity(m.dof());
   for (std::size_t i = 0; i < m.dof(); ++i)
     velocity[i] = rtc::kDefaultSpeedFraction * m.joints[i].max_velocity;
+  int status = kOk;
   const auto send = [&](TestCommand c) {
-    while (!queue->push(c)) r.session->wait_for(r.session->period());
+    // Without control nobody empties the queue: give up rather than wait for ever.
+    while (!queue->push(c)) {
+      if (!r.session->controlling() || stopped()) return;
+      r.session->wait_for(r.session->period());
+    }
     r.session->wait_for(r.session->period());  // simulated time: let the command take effect
   };
-  int status = kOk;
+  // Control ended (a limit, a fault): say why at once, count it, and control again.
   const auto check = [&] {
     const rtc::Termination t = r.session->termination();
     if (!t.ended()) return;
+    std::fflush(stdout);
     rtc::print_terminate_code(t, stdout);
     status = kFailure;
     r.session->release();
-    start();
-    fmt::print("control restarted\n");
+    if (stopped()) return;
+    try {
+      start();
+      fmt::print("control restarted\n");
+    } catch (const rtc::SessionError& e) {
+      std::fflush(stdout);
+      io::eprint("control could not be restarted: {}\n", e.what());
+    }
+  };
+  const auto failed = [&](const std::string& why) {
+    std::fflush(stdout);  // the error after what came before it
+    io::eprint("{}\n", why);
+    status = kFailure;
   };
 
   fmt::print("jointtest on {} ({} joints), {} time, period {:.3f} ms. ? for the menu.\n", m.title,
              m.dof(), r.simulated() ? "simulated" : "real", r.period_s() * 1e3);
+  io::StopAwareInput buffer(STDIN_FILENO);  // ends a wait for a line on Ctrl-C / SIGTERM
+  std::istream input(&buffer);
   std::string line;
-  LineReader input(interrupted);
-  while (input.next(line)) {
-    std::istringstream in(line);
-    std::string word;
-    if (!(in >> word)) continue;
-    const char letter = word[0];
-    double value = 0;
-    const bool has_value = static_cast<bool>(in >> value);
+  bool quit = false;
+  while (!quit && !stopped() && std::getline(input, line)) {
+    JointtestLine c;
+    try {
+      c = parse_jointtest_line(line, m, joint);
+    } catch (const io::ParseError& e) {
+      failed(e.what());
+      continue;
+    }
+    const char letter = c.letter;
     const kin::Joint& jm = m.joints[joint];
-    const auto need_value = [&](const char* what) {
-      if (!has_value || !std::isfinite(value)) {
-        fmt::print(stderr, "{}: give {} after the letter, e.g. \"{} 10\"\n", letter, what, letter);
-        return false;
-      }
-      return true;
-    };
-    switch (word.size() == 1 ? letter : '\0') {
+    if (!r.session->controlling() && letter != 'x' && letter != '?' && letter != 'q' &&
+        letter != 'j' && letter != 'v' && letter != '\0') {
+      failed(fmt::format("{}: control has ended and could not be restarted; q quits", letter));
+      continue;
+    }
+    switch (letter) {
+      case '\0':
+        break;
       case 'j':
-        if (need_value("a joint number")) {
-          if (value < 1 || value > static_cast<double>(m.dof())) {
-            fmt::print(stderr, "j: joints are 1 to {}\n", m.dof());
-          } else {
-            joint = static_cast<std::size_t>(value) - 1;
-            fmt::print("joint {} ({})\n", joint + 1, m.joints[joint].name);
-          }
-        }
+        joint = c.joint;
+        fmt::print("joint {} ({})\n", joint + 1, m.joints[joint].name);
         break;
       case 'v':
-        if (need_value(revolute(jm) ? "a speed in deg/s" : "a speed in mm/s")) {
-          velocity[joint] = std::abs(from_shown(jm, value));
-          fmt::print("joint {} velocity {:.3f} {}/s\n", joint + 1, shown(jm, velocity[joint]),
-                     unit(jm));
-        }
+        velocity[joint] = from_shown(jm, c.value);
+        fmt::print("joint {} velocity {:.3f} {}/s\n", joint + 1, shown(jm, velocity[joint]),
+                   unit(jm));
         break;
       case 'm':
-        if (need_value(revolute(jm) ? "a position in deg" : "a position in mm")) {
-          send({'m', static_cast<std::uint8_t>(joint), from_shown(jm, value) - jm.lower,
-                velocity[joint]});
-        }
-        break;
       case 'M':
-        if (need_value(revolute(jm) ? "a position in deg" : "a position in mm")) {
-          send({'M', static_cast<std::uint8_t>(joint), from_shown(jm, value) - jm.lower,
-                velocity[joint]});
-        }
+        send({letter, static_cast<std::uint8_t>(joint), from_shown(jm, c.value) - jm.lower,
+              velocity[joint]});
         break;
       case 's':
         send({'s', static_cast<std::uint8_t>(joint), 0, 0});
@@ -591,33 +572,25 @@ int run_jointtest(const RtcArgs& a) {
         break;
       case 'o':
       case 'O':
-        if (need_value("a bit number 0..15")) {
-          if (value < 0 || value > 15) {
-            fmt::print(stderr, "{}: output bits are 0 to 15\n", letter);
-          } else {
-            send({letter, 0, std::floor(value), 0});
-          }
-        }
+        send({letter, 0, c.value, 0});
         break;
       case 'x':
         print_positions_detailed(m, r.session->how());
         break;
       case 'w':
-        if (need_value("a time in seconds")) r.session->wait_for(to_ns(std::max(0.0, value)));
+        r.session->wait_for(c.duration);  // ends early on a stop signal or when control ends
         break;
       case 'r':
-        if (need_value("a period in ms")) {
+        try {
+          r.session->release();
+          r.session->set_period(c.duration);
+          start();
+          fmt::print("sample period {:.3f} ms\n", r.period_s() * 1e3);
+        } catch (const rtc::SessionError& e) {
+          failed(fmt::format("r: {}", e.what()));
           try {
-            const auto p = parse_period(fmt::format("{}ms", value));
-            r.session->release();
-            r.session->set_period(p);
-            start();
-            fmt::print("sample period {:.3f} ms\n", r.period_s() * 1e3);
-          } catch (const BadArgument& e) {
-            fmt::print(stderr, "r: {}\n", e.message);
-          } catch (const rtc::SessionError& e) {
-            fmt::print(stderr, "r: {}\n", e.what());
             start();  // control again at the period it had
+          } catch (const rtc::SessionError&) {
           }
         }
         break;
@@ -629,52 +602,47 @@ int run_jointtest(const RtcArgs& a) {
       case 'z':
       case 'X': {
         if (!r.rcu) {
-          fmt::print("{}: {} has no Microbo joint controllers (thesis Appendix B)\n", letter,
-                     m.name);
+          failed(fmt::format("{}: {} has no Microbo joint controllers (thesis Appendix B)", letter,
+                             m.name));
           break;
         }
-        const double limit = letter == 'a' ? 65535 : 255;
-        if (letter != 'X' && need_value("a value in the controller's units")) {
-          if (value < 0 || value > limit) {
-            fmt::print(stderr, "{}: the value must be 0 to {}\n", letter, limit);
-            break;
-          }
-        } else if (letter != 'X') {
-          break;
-        }
-        send({letter, static_cast<std::uint8_t>(joint), std::floor(value), 0});
+        send({letter, static_cast<std::uint8_t>(joint), c.value, 0});
         if (letter == 'X') {
           r.session->wait_for(r.session->period());  // read during the next sample
           const rtc::How h = r.session->how();
           if (h.examined_joint != static_cast<int>(joint)) {
-            fmt::print(stderr, "X: joint {} did not answer\n", joint + 1);
+            failed(fmt::format("X: joint {} did not answer", joint + 1));
             break;
           }
           fmt::print("joint {} motor parameters:", joint + 1);
           for (const std::uint8_t b : h.motor_parameters) fmt::print(" {}", b);
           fmt::print("\n");
         } else {
-          fmt::print("joint {} {} {}\n", joint + 1, rtc::to_string(setting_of(letter)), value);
+          fmt::print("joint {} {} {}\n", joint + 1, rtc::to_string(setting_of(letter)), c.value);
         }
         break;
       }
       case 'q':
-        check();
-        r.session->release();
-        return status;
+        quit = true;
+        break;
       case '?':
         fmt::print("{}", kTestMenu);
         break;
-      default:
-        fmt::print(stderr, "unknown command \"{}\": type ? for the menu\n", word);
+      default:  // parse_jointtest_line knows every letter above and no other
         break;
     }
     check();
   }
-  r.session->release();
-  if (interrupted) {
-    fmt::print("interrupted: control released, the arm holds\n");
-    return kFailure;
+  const rtc::Termination end = r.session->release();
+  if (end.ended()) {
+    rtc::print_terminate_code(end, stdout);
+    status = kFailure;
+  }
+  if (buffer.error() != 0) failed(fmt::format("reading stdin: {}", std::strerror(buffer.error())));
+  if (stopped()) {
+    fmt::print("stopped by a signal: control released, the arm holds\n");
+    std::fflush(stdout);
+    return io::stop_exit_code();
   }
   return status;
 }

@@ -1,8 +1,15 @@
 #include "teach_command.hpp"
 
+#include <unistd.h>
+
+#include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <iostream>
 
+#include "rccx/io/console.hpp"
+#include "rccx/io/input.hpp"
+#include "rccx/io/signals.hpp"
 #include "rccx/math/units.hpp"
 #include "rccx/rccl/teach.hpp"
 #include "rccx/rtc/simulated_robot.hpp"
@@ -15,21 +22,52 @@ struct TeachArgs {
   std::string db;
 };
 
+/// Installs the stop handlers for the whole run: Ctrl-C while no control runs must end the
+/// console cleanly too, not kill it.
+struct StopHandlers {
+  StopHandlers() noexcept { io::install_stop_handlers(); }
+  ~StopHandlers() { io::restore_stop_handlers(); }
+  StopHandlers(const StopHandlers&) = delete;
+  StopHandlers& operator=(const StopHandlers&) = delete;
+};
+
 int run_teach(const TeachArgs& a) {
   const std::string file = database_file(a.db);
+  const StopHandlers handlers;
   try {
     rccl::PositionDb db(file);
     rtc::SimulatedRobot robot(a.robot.model());
     rccl::Manipulator arm(*robot.session);
     arm.start();
+    io::StopAwareInput input(STDIN_FILENO);  // Ctrl-C ends a wait for a line
+    std::istream in(&input);
     const rccl::Taught t = rccl::teach_loop(
-        arm, {std::cin, std::cout, &db, [&](std::size_t j, double e) { robot.push(j, e); }});
+        arm, {in, std::cout, &db, [&](std::size_t j, double e) { robot.push(j, e); }});
     fmt::print("\ntaught T6: p = ({:.3f}, {:.3f}, {:.3f}) mm\n", t.t6.p.x * 1e3, t.t6.p.y * 1e3,
                t.t6.p.z * 1e3);
-    const rtc::Termination end = arm.stop_control();
-    return end.ended() ? kFailure : kOk;
+    std::fflush(stdout);
+    const rtc::Termination end = t.termination.ended() ? t.termination : arm.stop_control();
+    if (t.stopped_by_signal || input.stopped()) {
+      io::eprint("rccx teach: stopped by a signal; control released\n");
+      return io::stop_exit_code();
+    }
+    if (end.ended()) {
+      io::eprint("rccx teach: control ended: {}: {}\n", rtc::to_string(end.code),
+                 rtc::describe(end.code));
+      return kFailure;
+    }
+    if (input.error() != 0) {
+      io::eprint("rccx teach: reading stdin failed: {}\n", std::strerror(input.error()));
+      return kFailure;
+    }
+    if (t.failed_commands > 0) {
+      io::eprint("rccx teach: {} command{} failed\n", t.failed_commands,
+                 t.failed_commands == 1 ? "" : "s");
+      return kFailure;
+    }
+    return kOk;
   } catch (const rccl::DatabaseError& e) {
-    fmt::print(stderr, "rccx teach: {}\n", e.what());
+    io::eprint("rccx teach: {}\n", e.what());
     return kFailure;
   } catch (const std::invalid_argument& e) {
     throw BadArgument{e.what()};

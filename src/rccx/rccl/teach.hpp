@@ -15,11 +15,19 @@
 //   h / H          open / close the hand
 //   save NAME      store T6 in the position database as NAME
 //   e              exit: the call returns
+//
+// Every line is read strictly (parse_teach_command, pure so it can be fuzzed): whole tokens,
+// finite numbers in range with their units, joint numbers 1 .. dof, no extra words. A refused
+// line moves nothing and says why. When control ends (a fault, a limit, Ctrl-C) the loop says
+// so at once and refuses motion from then on; `e` still exits. A stop signal (SIGINT, SIGTERM)
+// ends the loop after the command in progress.
 #pragma once
 
+#include <cstdint>
 #include <functional>
 #include <iosfwd>
 #include <string>
+#include <string_view>
 
 #include "rccx/rccl/manipulator.hpp"
 #include "rccx/rccl/position_db.hpp"
@@ -36,10 +44,67 @@ struct TeachIo {
 };
 
 struct Taught {
-  math::Transform t6;         ///< m, rad
-  kin::JointVector q;         ///< rad / m
-  bool ended_by_exit = true;  ///< false: the input ran out before `e`
+  math::Transform t6;               ///< m, rad
+  kin::JointVector q;               ///< rad / m
+  bool ended_by_exit = true;        ///< false: the input ran out before `e` (or a stop signal came)
+  std::size_t failed_commands = 0;  ///< lines refused or that failed
+  /// How control ended during the loop (code none: it still runs, the arm holds).
+  rtc::Termination termination;
+  bool stopped_by_signal = false;  ///< SIGINT / SIGTERM ended the loop
+
+  /// True when everything typed was done and control still runs.
+  [[nodiscard]] bool ok() const noexcept {
+    return failed_commands == 0 && !termination.ended() && !stopped_by_signal;
+  }
 };
+
+/// The largest pendant step (`s V`), deg or mm: one jog never swings a joint further.
+inline constexpr double kMaxTeachStep = 90.0;
+/// The largest effort of a simulated push, N m or N.
+inline constexpr double kMaxPushEffort = 1000.0;
+/// The longest push, s.
+inline constexpr double kMaxPushSeconds = 600.0;
+
+/// One line of the teach loop, read.
+struct TeachCommand {
+  enum class Kind : std::uint8_t {
+    none,  ///< a blank line
+    exit,
+    menu,
+    zero_gravity_on,
+    zero_gravity_off,
+    push,
+    move_joint,
+    pendant,
+    examine_deg,
+    examine_rad,
+    examine_range,
+    motor_parameters,
+    hand_open,
+    hand_close,
+    save,
+    // pendant mode
+    leave_pendant,
+    set_step,
+    jog_joint,
+    jog_tool,  ///< along a base axis
+    turn_tool  ///< about a base axis
+  };
+  Kind kind = Kind::none;
+  std::size_t joint = 0;  ///< 0 .. dof - 1
+  /// move_joint: the goal (rad or m, within the joint's limits); push: the effort (N m or N);
+  /// set_step: the step (deg or mm).
+  double value = 0.0;
+  double seconds = 0.0;  ///< push
+  int sign = 0;          ///< jogs: +1 or -1
+  std::size_t axis = 0;  ///< jog_tool / turn_tool: 0 x, 1 y, 2 z
+  std::string name;      ///< save
+};
+
+/// Reads one line as the teach loop does (pendant mode takes the pendant's commands). Throws
+/// io::ParseError saying what is wrong and what to write instead.
+TeachCommand parse_teach_command(std::string_view line, const kin::RobotModel& model,
+                                 bool pendant_mode);
 
 /// Runs the teach loop on `arm` (after waiting for its queue to complete) until `e`.
 Taught teach_loop(Manipulator& arm, TeachIo io);
