@@ -285,6 +285,8 @@ TEST_F(CliDbBadInput, ExportFailuresLeaveTheOldFileAndNoTemporary) {
       {"db --db {db} export {dir}/ro/out.json", 1, "cannot write", old_file_in("ro"), false, true,
        true},
       {"db --db {db} export ''", 2, "empty"},
+      {"db --db {db} export /dev/full", 1, "cannot write /dev/full: No space left on device"},
+      {"db --db /dev/null list", 2, "not a regular file"},
       {"db --db {db} export {dir}/ok/out.json", 0, "", old_file_in("ok")},
   });
   if (::geteuid() != 0) {

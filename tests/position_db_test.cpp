@@ -123,6 +123,15 @@ TEST(PositionDb, MissingForeignAndNewerFilesGiveClearErrors) {
   EXPECT_NE(message.find("not a database"), std::string::npos) << message;
   EXPECT_EQ(std::filesystem::file_size(foreign.path), size);  // untouched
 
+  // SQLite would open these and put a -wal file beside them.
+  EXPECT_NE(error_of([&] {
+              PositionDb db(std::filesystem::temp_directory_path());
+            }).find("is a directory"),
+            std::string::npos);
+  EXPECT_NE(error_of([&] { PositionDb db("/dev/null"); }).find("not a regular file"),
+            std::string::npos);
+  EXPECT_FALSE(std::filesystem::exists("/dev/null-wal"));
+
   TempDb newer;
   { PositionDb db(newer.path); }
   sqlite3* raw = nullptr;
@@ -322,7 +331,9 @@ TEST(PositionDb, RobotNotesAndConfigurationsAreCheckedAsUtf8WithALength) {
   refused(t, "robot name");
   t.robot = "puma 560";
   refused(t, "not a name");
-  t.robot = "micr\xc3" "bo";  // not UTF-8, not ASCII
+  t.robot =
+      "micr\xc3"
+      "bo";  // not UTF-8, not ASCII
   refused(t, "not a name");
   t.robot = std::string(33, 'r');
   refused(t, "at most 32");

@@ -1,5 +1,6 @@
 #include "db_command.hpp"
 
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -88,6 +89,21 @@ void write_stdout(std::string_view text) {
   }
 }
 
+/// Writes `text` to an existing file that is not a regular one (a device, a named pipe), which
+/// an atomic replacement would turn into a regular file.
+void write_device(const std::string& path, std::string_view text) {
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC);
+  if (fd < 0) {
+    throw io::FileError(fmt::format("cannot write {}: {}", path, std::strerror(errno)));
+  }
+  const int e = io::write_all(fd, text.data(), text.size());
+  const int c = ::close(fd) == 0 ? 0 : errno;
+  if (e != 0 || c != 0) {
+    throw io::FileError(fmt::format("cannot write {}: {}; the export is incomplete", path,
+                                    std::strerror(e != 0 ? e : c)));
+  }
+}
+
 void check_robot(const std::string& robot, std::string_view what) {
   try {
     io::check_name(robot, what, rccl::kMaxRobotName);
@@ -173,9 +189,12 @@ int run_db(const std::string& what, const DbArgs& a) {
   if (what == "show" || what == "put" || what == "rm") check_transform_name(a.name);
   const auto wait = busy_timeout(a);
   std::error_code ec;
-  if (std::filesystem::is_directory(file, ec)) {
-    throw BadArgument{fmt::format("position database {} is a directory; name a file with --db",
-                                  io::quoted(file))};
+  if (const auto type = std::filesystem::status(file, ec).type();
+      type != std::filesystem::file_type::not_found &&
+      type != std::filesystem::file_type::regular && !ec) {
+    throw BadArgument{fmt::format(
+        "position database {} is {}; name a database file with --db", io::quoted(file),
+        type == std::filesystem::file_type::directory ? "a directory" : "not a regular file")};
   }
 
   if (what == "list") {
@@ -232,6 +251,9 @@ int run_db(const std::string& what, const DbArgs& a) {
     const std::string text = rccl::position_export_json(db.list(a.robot));
     if (to_stdout) {
       write_stdout(text);
+    } else if (std::filesystem::exists(a.path, ec) &&
+               !std::filesystem::is_regular_file(a.path, ec)) {
+      write_device(a.path, text);  // /dev/stdout, a pipe: not to be replaced by a file
     } else {
       io::write_file_atomically(a.path, text);  // the old file, or the new one whole
     }

@@ -242,9 +242,13 @@ PositionDb::PositionDb(const std::filesystem::path& file, Open mode,
                     "first put, e.g. `rccx db put`, or check the path)",
                     file.string()));
   }
-  if (std::filesystem::is_directory(file, ec)) {
-    throw DatabaseError(fmt::format("position database {} is a directory; name a file (e.g. {})",
-                                    file.string(), (file / "rccx.db").string()));
+  if (const auto type = std::filesystem::status(file, ec).type();
+      !ec && type != std::filesystem::file_type::not_found &&
+      type != std::filesystem::file_type::regular) {
+    // SQLite would open a device or a directory and put its -wal file beside it.
+    throw DatabaseError(fmt::format(
+        "position database {} is {}; name a database file", file.string(),
+        type == std::filesystem::file_type::directory ? "a directory" : "not a regular file"));
   }
   const int flags = SQLITE_OPEN_READWRITE | (mode == Open::create ? SQLITE_OPEN_CREATE : 0) |
                     SQLITE_OPEN_FULLMUTEX;
