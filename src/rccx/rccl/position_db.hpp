@@ -9,6 +9,9 @@
 //   auto pick = db.constant("microbo", "PICK");                 // a TransformPtr for equations
 //
 // Names: 1 to 32 characters (the thesis raised RCCL's limit to 32), letters, digits and _ - .
+// Robot names follow the same rule; a configuration is up to 8 letters; a note is UTF-8 text
+// without control characters, up to 1000 bytes. put() refuses anything else (InvalidTransform),
+// so what is stored can be printed and exported as it is.
 #pragma once
 
 #include <chrono>
@@ -35,15 +38,32 @@ class DatabaseError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// The database is held by another process (SQLITE_BUSY / SQLITE_LOCKED) for longer than the
+/// busy timeout: nothing is wrong with it; try again when the other process has finished.
+class DatabaseBusy : public DatabaseError {
+ public:
+  using DatabaseError::DatabaseError;
+};
+
+/// A transform refused before the database is touched: a bad name, robot, configuration or
+/// note, or a value that is not rigid. Bad input rather than a failing database.
+class InvalidTransform : public DatabaseError {
+ public:
+  using DatabaseError::DatabaseError;
+};
+
 inline constexpr std::size_t kMaxTransformName = 32;
+inline constexpr std::size_t kMaxRobotName = 32;
+inline constexpr std::size_t kMaxConfiguration = 8;  ///< letters, e.g. "lun"
+inline constexpr std::size_t kMaxNote = 1000;        ///< bytes of UTF-8
 
 struct StoredTransform {
-  std::string robot;  ///< the robot it belongs to ("microbo", "puma560" ...)
+  std::string robot;  ///< the robot it belongs to ("microbo", "puma560" ...), a name as `name`
   std::string name;   ///< 1 .. kMaxTransformName characters: letters, digits, _ - .
   math::Transform value = math::Transform::identity();  ///< m, rad
-  /// The arm configuration it was taught in ("lun" ...), or empty.
+  /// The arm configuration it was taught in ("lun" ...): up to 8 letters, or empty.
   std::string configuration;
-  std::string note;
+  std::string note;                 ///< UTF-8, no control characters but tab, up to kMaxNote bytes
   std::int64_t created_unix_s = 0;  ///< 0: put() stamps it the first time (an import keeps it)
   std::int64_t changed_unix_s = 0;  ///< 0: put() stamps it now (an import keeps it)
 };
@@ -57,7 +77,9 @@ class PositionDb {
     create,    ///< make the file when it is missing
     existing,  ///< a missing file is an error
   };
-  /// Opens (and when asked, creates) the database at `file`. Throws DatabaseError.
+  /// Opens (and when asked, creates) the database at `file`. Throws DatabaseError, or
+  /// DatabaseBusy when another process holds it for longer than `busy_timeout`. Several
+  /// processes may create the same new file at once.
   explicit PositionDb(const std::filesystem::path& file, Open mode = Open::create,
                       std::chrono::milliseconds busy_timeout = std::chrono::seconds(5));
   ~PositionDb();
@@ -73,6 +95,8 @@ class PositionDb {
   void put(const std::vector<StoredTransform>& all);
   /// Removes it; false when there was none.
   bool remove(std::string_view robot, std::string_view name);
+  /// The robots that have transforms stored, by name.
+  [[nodiscard]] std::vector<std::string> robots() const;
   /// The transforms of `robot` (every robot when empty) whose names match the glob `pattern`
   /// ("*", "P?", "PICK*"), by robot then name.
   [[nodiscard]] std::vector<StoredTransform> list(std::string_view robot = {},
@@ -87,16 +111,21 @@ class PositionDb {
   /// The schema version in the file.
   [[nodiscard]] int schema_version() const;
 
-  /// Throws DatabaseError unless `name` is a valid transform name.
+  /// Throws InvalidTransform unless `name` is a valid transform name.
   static void check_name(std::string_view name);
+  /// Throws InvalidTransform unless `robot` is a valid robot name (the rule of check_name).
+  static void check_robot_name(std::string_view robot);
+  /// Throws InvalidTransform unless put() would store `t`: every rule above, without opening
+  /// a database.
+  static void check(const StoredTransform& t);
 
  private:
   void migrate();
-  static void check(const StoredTransform& t);
   void insert(const StoredTransform& t);
   [[nodiscard]] StoredTransform require(std::string_view robot, std::string_view name) const;
 
   std::filesystem::path path_;
+  std::chrono::milliseconds busy_timeout_;
   sqlite3* db_ = nullptr;
 };
 

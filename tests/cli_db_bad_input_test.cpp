@@ -1,0 +1,370 @@
+// `rccx db` fed bad input, one row each: the arguments (and the files or the lock prepared
+// for it), the exit code, a piece of the one-line message, and that the database is as it was
+// (a bad name must not even create the file). Exit codes: 1 the database or a file failed,
+// 2 bad input.
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+#include <sqlite3.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <array>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <iterator>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "rccx/rccl/position_db.hpp"
+#include "rccx/rccl/position_export.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace rccx;
+
+struct CliRun {
+  int exit_code = -1;
+  std::string out;  // stdout and stderr
+};
+
+/// Runs `rccx ARGUMENTS` through bash (so `ARGUMENTS` may redirect and write bytes as $'\xff').
+CliRun rccx_cli(const std::string& arguments) {
+  const std::string command = "exec " + std::string(RCCX_CLI) + " 2>&1 " + arguments;
+  ::setenv("RCCX_TEST_COMMAND", command.c_str(), 1);  // no quoting of the command itself
+  CliRun run;
+  FILE* pipe = popen("exec bash -c \"$RCCX_TEST_COMMAND\"", "r");
+  if (pipe == nullptr) return run;
+  std::array<char, 4096> buffer{};
+  while (std::fgets(buffer.data(), static_cast<int>(buffer.size()), pipe) != nullptr) {
+    run.out += buffer.data();
+  }
+  const int status = pclose(pipe);
+  run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return run;
+}
+
+std::string read(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), {}};
+}
+
+void write(const fs::path& file, const std::string& text) {
+  std::ofstream(file, std::ios::binary) << text;
+}
+
+/// What the database holds, to compare before and after ("<none>": no file).
+std::string snapshot(const fs::path& db) {
+  if (!fs::exists(db)) return "<none>";
+  rccl::PositionDb d(db, rccl::PositionDb::Open::existing);
+  return rccl::position_export_json(d.list());
+}
+
+/// A second connection holding the write lock until destroyed.
+struct Lock {
+  explicit Lock(const fs::path& db) {
+    sqlite3_open(db.c_str(), &raw);
+    sqlite3_exec(raw, "BEGIN IMMEDIATE", nullptr, nullptr, nullptr);
+    sqlite3_exec(raw, "DELETE FROM transforms WHERE name = 'none'", nullptr, nullptr, nullptr);
+  }
+  ~Lock() {
+    sqlite3_exec(raw, "ROLLBACK", nullptr, nullptr, nullptr);
+    sqlite3_close(raw);
+  }
+  Lock(const Lock&) = delete;
+  Lock& operator=(const Lock&) = delete;
+  sqlite3* raw = nullptr;
+};
+
+constexpr const char* kT = "1,0,0,0.3,0,1,0,0.1,0,0,1,0.2";
+constexpr const char* kRows = "[1,0,0,0.1, 0,1,0,0.2, 0,0,1,0.3]";
+
+std::string export_with(const std::string& transforms) {
+  return std::string(R"({"rccx_position_database": 1, "transforms": )") + transforms + "}";
+}
+std::string entry(const std::string& robot, const std::string& name, const std::string& extra = "",
+                  const std::string& rows = kRows) {
+  return fmt::format(R"({{"robot": "{}", "name": "{}", "T_rows_m": {}{}}})", robot, name, rows,
+                     extra);
+}
+
+/// One row. In `args`, {db} is the database (which holds microbo/KEEP), {dir} a scratch folder;
+/// `prepare` may write files there and return something that lives during the run (a lock).
+using Prepare = std::function<std::shared_ptr<void>(const fs::path& dir, const fs::path& db)>;
+
+struct Case {
+  Case(std::string args_, int exit_code_, std::string message_, Prepare prepare_ = {},
+       bool fresh_db_ = false, bool db_unchanged_ = true, bool skip_as_root_ = false)
+      : args(std::move(args_)),
+        exit_code(exit_code_),
+        message(std::move(message_)),
+        prepare(std::move(prepare_)),
+        fresh_db(fresh_db_),
+        db_unchanged(db_unchanged_),
+        skip_as_root(skip_as_root_) {}
+  std::string args;
+  int exit_code;
+  std::string message;  // a piece of the output
+  Prepare prepare;
+  bool fresh_db;      // no database file at all before the run
+  bool db_unchanged;  // false: the run is meant to store something
+  bool skip_as_root;  // file permissions do not stop root
+};
+
+std::shared_ptr<void> file_in(const fs::path& dir, const std::string& name,
+                              const std::string& text) {
+  write(dir / name, text);
+  return nullptr;
+}
+
+auto with_file(std::string name, std::string text) {
+  return [name, text](const fs::path& dir, const fs::path&) { return file_in(dir, name, text); };
+}
+
+class CliDbBadInput : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / fmt::format("rccx_cli_db_bad_{}", ::getpid());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override {
+    std::error_code ec;
+    fs::permissions(dir_ / "ro", fs::perms::owner_all, ec);
+    fs::remove_all(dir_, ec);
+  }
+
+  void run_all(const std::vector<Case>& cases) {
+    int n = 0;
+    for (const Case& c : cases) {
+      SCOPED_TRACE(fmt::format("row {}: rccx {}", n++, c.args));
+      if (c.skip_as_root && ::geteuid() == 0) continue;
+      const fs::path db = dir_ / "cell.db";
+      for (const char* s : {"", "-wal", "-shm"}) fs::remove(db.string() + s);
+      if (!c.fresh_db) {
+        rccl::StoredTransform keep;
+        keep.robot = "microbo";
+        keep.name = "KEEP";
+        rccl::PositionDb(db).put(keep);
+      }
+      std::shared_ptr<void> held;
+      if (c.prepare) held = c.prepare(dir_, db);
+      const std::string before = snapshot(db);
+      std::string args = c.args;
+      for (const auto& [key, value] :
+           {std::pair<std::string, std::string>{"{db}", db.string()}, {"{dir}", dir_.string()}}) {
+        for (std::size_t at; (at = args.find(key)) != std::string::npos;) {
+          args.replace(at, key.size(), value);
+        }
+      }
+      const CliRun run = rccx_cli(args);
+      EXPECT_EQ(run.exit_code, c.exit_code) << run.out;
+      EXPECT_NE(run.out.find(c.message), std::string::npos)
+          << "expected \"" << c.message << "\" in:\n"
+          << run.out;
+      if (c.exit_code != 0) {
+        // One clear line, and not a crash or an exception's name.
+        EXPECT_EQ(run.out.rfind("error: ", 0), 0u) << run.out;
+        EXPECT_EQ(run.out.find("terminate"), std::string::npos) << run.out;
+      }
+      if (c.db_unchanged) {
+        EXPECT_EQ(snapshot(db), before);
+      }
+      held.reset();
+    }
+  }
+
+  fs::path dir_;
+};
+
+TEST_F(CliDbBadInput, PutRefusesBadArgumentsBeforeTouchingTheDatabase) {
+  const std::string put = "db --db {db} put --robot microbo P --T ";
+  run_all({
+      {put + "1,0,0,0.3,0,1,0,0.1,0,0,1", 2, "11 numbers given, 12 needed"},
+      {put + kT + ",5", 2, "13 numbers given, 12 needed"},
+      {put + "1,0,0,inf,0,1,0,0.1,0,0,1,0.2", 2, "\"inf\" is not a number"},
+      {put + "1,0,0,nan,0,1,0,0.1,0,0,1,0.2", 2, "\"nan\" is not a number"},
+      {put + "1,0,0,5abc,0,1,0,0.1,0,0,1,0.2", 2, "\"5abc\" is not a number"},
+      {put + "1,0,0,1e400,0,1,0,0.1,0,0,1,0.2", 2, "too large"},
+      {put + "1,0,0,,0,1,0,0.1,0,0,1,0.2", 2, "missing"},
+      {put + "''", 2, "empty"},
+      {put + "1,0,0,0.3,0,1,0,0.1,0,0,2,0.2", 2, "rigid"},
+      {"db --db {db} put --robot microbo 'TWO WORDS' --T " + std::string(kT), 2, "not a name"},
+      {"db --db {db} put --robot microbo " + std::string(33, 'N') + " --T " + kT, 2, "at most 32"},
+      {"db --db {db} put --robot microbo '' --T " + std::string(kT), 2, "empty"},
+      {"db --db {db} put --robot '' P --T " + std::string(kT), 2, "empty"},
+      {"db --db {db} put --robot $'micr\\xf6bo' P --T " + std::string(kT), 2, "not a name"},
+      {"db --db {db} put --robot microbo $'P\\xff' --T " + std::string(kT), 2, "not a name"},
+      {put + kT + " --note $'caf\\xe9'", 2, "not UTF-8"},
+      {put + kT + " --note $'two\\nlines'", 2, "control character"},
+      {put + kT + " --note $'bell\\x07'", 2, "control character"},
+      {put + kT + " --note " + std::string(1001, 'n'), 2, "at most 1000"},
+      {put + kT + " --config l1n", 2, "configuration"},
+      {put + kT + " --config abcdefghi", 2, "configuration"},
+      {"db --db {db} --wait soon put --robot microbo P --T " + std::string(kT), 2, "--wait"},
+      {"db --db '' put --robot microbo P --T " + std::string(kT), 2, "empty"},
+      {"db --db {dir} put --robot microbo P --T " + std::string(kT), 2, "is a directory"},
+      // A misspelt robot is refused, with the known ones and how to declare a new one.
+      {"db --db {db} put --robot pmua560 P --T " + std::string(kT), 2,
+       "\"pmua560\" is not a known robot (known: microbo, puma260, puma560, stanford); check "
+       "the spelling, or add --new-robot"},
+      // A bad name does not create the file.
+      {"db --db {db} put --robot microbo 'A B' --T " + std::string(kT), 2, "not a name", {}, true},
+      {"db --db {db} put --robot pmua560 P --T " + std::string(kT),
+       2,
+       "not a known robot",
+       {},
+       true},
+      // What may be stored is.
+      {"db --db {db} put --robot gantry P --new-robot --T " + std::string(kT),
+       0,
+       "",
+       {},
+       false,
+       false},
+      {put + kT + " --note 'über dem Tisch' --config lun", 0, "", {}, false, false},
+  });
+  // gantry is now known, so a second put needs no --new-robot.
+  const fs::path db = dir_ / "cell.db";
+  EXPECT_EQ(
+      rccx_cli("db --db " + db.string() + " put --robot gantry P --new-robot --T " + kT).exit_code,
+      0);
+  EXPECT_EQ(rccx_cli("db --db " + db.string() + " put --robot gantry Q --T " + kT).exit_code, 0);
+}
+
+TEST_F(CliDbBadInput, ShowListRmRefuseBadNamesAndReportMissingFiles) {
+  run_all({
+      {"db --db {db} show --robot microbo NOPE", 2, "has no NOPE for robot microbo"},
+      {"db --db {db} show --robot microbo 'A B'", 2, "not a name"},
+      {"db --db {db} rm --robot microbo NOPE", 2, "has no NOPE"},
+      {"db --db {db} list ''", 2, "empty"},
+      {"db --db {db} list --robot $'\\xff'", 2, "not a name"},
+      {"db --db {db} list", 1, "does not exist", {}, true},
+      {"db --db {dir}/not-a-db list", 1, "is it an rccx database?",
+       with_file("not-a-db", std::string(8192, 'x'))},
+  });
+}
+
+TEST_F(CliDbBadInput, ALockedDatabaseIsBusyNotDamaged) {
+  const auto lock = [](const fs::path&, const fs::path& db) {
+    return std::static_pointer_cast<void>(std::make_shared<Lock>(db));
+  };
+  run_all({
+      {"db --db {db} --wait 0.2 put --robot microbo P --T " + std::string(kT), 1,
+       "is busy: another process is writing it (waited 0.2 s); try again when it has finished",
+       lock},
+      {"db --db {db} --wait 0.2 rm --robot microbo KEEP", 1, "is busy", lock},
+      {"db --db {db} --wait 0.2 import {dir}/in.json", 1, "is busy",
+       [lock](const fs::path& dir, const fs::path& db) {
+         file_in(dir, "in.json", export_with("[" + entry("microbo", "P") + "]"));
+         return lock(dir, db);
+       }},
+  });
+}
+
+TEST_F(CliDbBadInput, ExportFailuresLeaveTheOldFileAndNoTemporary) {
+  const std::string good = "{\"an\": \"old good export\"}\n";
+  const auto old_file_in = [good](const std::string& sub) {
+    return [good, sub](const fs::path& dir, const fs::path&) {
+      fs::create_directories(dir / sub);
+      write(dir / sub / "out.json", good);
+      if (sub == "ro") fs::permissions(dir / sub, fs::perms::owner_read | fs::perms::owner_exec);
+      return std::shared_ptr<void>();
+    };
+  };
+  run_all({
+      {"db --db {db} export > /dev/full", 1, "cannot write to standard output"},
+      {"db --db {db} export {dir}", 2, "is a directory"},
+      {"db --db {db} export {dir}/missing/out.json", 1, "cannot write"},
+      {"db --db {db} export {dir}/ro/out.json", 1, "cannot write", old_file_in("ro"), false, true,
+       true},
+      {"db --db {db} export ''", 2, "empty"},
+      {"db --db {db} export /dev/full", 1, "cannot write /dev/full: No space left on device"},
+      {"db --db /dev/null list", 2, "not a regular file"},
+      {"db --db {db} export {dir}/ok/out.json", 0, "", old_file_in("ok")},
+  });
+  if (::geteuid() != 0) {
+    fs::permissions(dir_ / "ro", fs::perms::owner_all);
+    EXPECT_EQ(read(dir_ / "ro" / "out.json"), good);  // byte for byte
+    EXPECT_EQ(std::distance(fs::directory_iterator(dir_ / "ro"), fs::directory_iterator()), 1);
+  }
+  EXPECT_NE(read(dir_ / "ok" / "out.json").find("KEEP"), std::string::npos);
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir_ / "ok"), fs::directory_iterator()), 1);
+}
+
+TEST_F(CliDbBadInput, ImportIsStrictAndAllOrNothing) {
+  const std::string imp = "db --db {db} import {dir}/in.json";
+  const auto in = [](const std::string& text) { return with_file("in.json", text); };
+  const std::string good = entry("microbo", "GOOD");
+  run_all({
+      {"db --db {db} import {dir}", 2, "is a directory; name a file"},
+      {"db --db {db} import {dir}/missing.json", 2, "No such file"},
+      {"db --db {db} import ''", 2, "empty"},
+      {imp, 2, "not JSON", in("")},
+      {imp, 2, "not JSON", in("{\"rccx_position_database\": 1, ")},
+      {imp, 2, "\"transforms\" is a null",
+       in(R"({"rccx_position_database": 1, "transforms": null})")},
+      {imp, 2, "written by a newer rccx",
+       in(R"({"rccx_position_database": 99, "transforms": []})")},
+      {imp, 2, "not a version", in(R"({"rccx_position_database": "1", "transforms": []})")},
+      {imp, 2, "no \"rccx_position_database\"", in(R"({"transforms": []})")},
+      {imp, 2, "transforms[1] (\"P\"), key \"T_rows_m\": 13 numbers",
+       in(export_with("[" + good + "," +
+                      entry("microbo", "P", "", "[1,0,0,0.1, 0,1,0,0.2, 0,0,1,0.3, 9]") + "]"))},
+      {imp, 2, "key \"colour\"",
+       in(export_with("[" + entry("microbo", "P", R"(, "colour": 1)") + "]"))},
+      {imp, 2, "not JSON",
+       in(export_with("[" + entry("microbo", "P", "", "[1,0,0,1e400, 0,1,0,0.2, 0,0,1,0.3]") +
+                      "]"))},
+      {imp, 2, "control character",
+       in(export_with("[" + good + "," + entry("microbo", "P", R"(, "note": "a\u0000b")") + "]"))},
+      {imp, 2, "not JSON",
+       in(export_with("[" + entry("microbo", "P", ", \"note\": \"\xff\"") + "]"))},
+      {imp, 2, "key \"name\"", in(export_with("[" + entry("microbo", "A B") + "]"))},
+      {imp, 2, "rigid",
+       in(export_with("[" + entry("microbo", "P", "", "[1,0,0,0, 0,1,0,0, 0,0,3,0]") + "]"))},
+      {imp, 2, "give each (robot, name) once", in(export_with("[" + good + "," + good + "]"))},
+      {imp, 2, "key \"created_unix_s\"",
+       in(export_with("[" + entry("microbo", "P", R"(, "created_unix_s": -1)") + "]"))},
+      {imp, 2,
+       "robot \"gantry\", \"pmua560\" not known (known: microbo, puma260, puma560, "
+       "stanford); check the file, or declare each new robot with --new-robot NAME",
+       in(export_with("[" + good + "," + entry("pmua560", "P") + "," + entry("gantry", "P") +
+                      "]"))},
+      {imp + " --new-robot gantry", 2, "robot \"pmua560\" not known",
+       in(export_with("[" + entry("pmua560", "P") + "," + entry("gantry", "P") + "]"))},
+      {imp, 2, "not known", in(export_with("[" + entry("gantry", "P") + "]")), true},
+      // What is good is imported, from a file or from standard input.
+      {imp + " --new-robot gantry", 0, "imported 2 transforms",
+       in(export_with("[" + good + "," + entry("gantry", "P") + "]")), false, false},
+      {"db --db {db} import - < {dir}/in.json", 0, "imported 1 transforms",
+       in(export_with("[" + good + "]")), false, false},
+  });
+}
+
+TEST_F(CliDbBadInput, OddBytesInAnOldFileDoNotStopShowListOrExport) {
+  const auto odd_row = [](const fs::path&, const fs::path& db) {
+    sqlite3* raw = nullptr;
+    sqlite3_open(db.c_str(), &raw);
+    sqlite3_exec(raw,
+                 "INSERT INTO transforms VALUES ('microbo', 'ODD', 1,0,0, 0,1,0, 0,0,1, "
+                 "0.1,0.2,0.3, 'm, rad', CAST(X'6cff' AS TEXT), CAST(X'410042ff0a1b' AS TEXT), "
+                 "5, 6)",
+                 nullptr, nullptr, nullptr);
+    sqlite3_close(raw);
+    return std::shared_ptr<void>();
+  };
+  run_all({
+      {"db --db {db} show --robot microbo ODD", 0, "\"A\\x00B\\xff\\x0a\\x1b\"", odd_row},
+      {"db --db {db} list", 0, "microbo ODD", odd_row},
+      {"db --db {db} export", 0, "\"ODD\"", odd_row},
+  });
+}
+
+}  // namespace
