@@ -121,7 +121,7 @@ TEST(Cli, BadArgumentsExitTwoAndSayWhatToDo) {
   const char* cases[][2] = {
       {"kin fk --robot puma560 0 0", "6 joints, got 2"},
       {"kin fk --robot nosuch 0 0 0 0 0 0", "known robots"},
-      {"kin ik --robot puma560 --T 1,0,0,0.5,0,1,0,0,0,0,1", "12 numbers"},
+      {"kin ik --robot puma560 --T 1,0,0,0.5,0,1,0,0,0,0,1", "12 needed"},
       {"kin ik --robot puma560 --T 1,0,0,0.5,0,2,0,0,0,0,1,0", "not a rotation matrix"},
       {"kin ik --robot puma560 --T 1,0,0,0.5,0,1,0,0,0,0,1,0 --config xyz", "use one of"},
       {"kin ik --robot puma560 --T 1,0,0,0.5,0,1,0,0,0,0,1,0 --config lun --near 0,0,0,0,0,0",

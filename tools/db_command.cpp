@@ -16,6 +16,7 @@
 #include "rccx/io/console.hpp"
 #include "rccx/io/file.hpp"
 #include "rccx/io/parse.hpp"
+#include "rccx/io/signals.hpp"
 #include "rccx/kinematics/robot_model.hpp"
 #include "rccx/math/units.hpp"
 #include "rccx/rccl/position_db.hpp"
@@ -284,7 +285,8 @@ int run_db(const std::string& what, const DbArgs& a) {
           from_stdin ? "standard input" : a.path, names, joined(k.robots))};
     }
     if (!k.db) k.db = std::make_unique<PositionDb>(file, PositionDb::Open::create, wait);
-    k.db->put(all);  // all or nothing
+    // All or nothing; a stop signal before the commit means nothing.
+    k.db->put(all, [] { return io::stop_count() > 0; });
     io::eprint("imported {} transforms into {}\n", all.size(), file);
   }
   return kOk;

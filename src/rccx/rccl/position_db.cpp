@@ -334,10 +334,16 @@ void PositionDb::put(const StoredTransform& t) {
   tr.commit();
 }
 
-void PositionDb::put(const std::vector<StoredTransform>& all) {
+void PositionDb::put(const std::vector<StoredTransform>& all,
+                     const std::function<bool()>& cancelled) {
   for (const StoredTransform& t : all) check(t);
   Transaction tr({db_, path_, busy_timeout_});
   for (const StoredTransform& t : all) insert(t);
+  if (cancelled && cancelled()) {
+    throw PutCancelled(fmt::format("position database {}: stopped before the commit; nothing "
+                                   "stored",
+                                   path_.string()));  // the Transaction rolls back
+  }
   tr.commit();
 }
 

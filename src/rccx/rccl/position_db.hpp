@@ -17,6 +17,7 @@
 #include <chrono>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -41,6 +42,12 @@ class DatabaseError : public std::runtime_error {
 /// The database is held by another process (SQLITE_BUSY / SQLITE_LOCKED) for longer than the
 /// busy timeout: nothing is wrong with it; try again when the other process has finished.
 class DatabaseBusy : public DatabaseError {
+ public:
+  using DatabaseError::DatabaseError;
+};
+
+/// A put of many that its caller cancelled (a stop signal) before it committed: nothing stored.
+class PutCancelled : public DatabaseError {
  public:
   using DatabaseError::DatabaseError;
 };
@@ -91,8 +98,11 @@ class PositionDb {
                                                    std::string_view name) const;
   /// Stores `t` (inserting or replacing; created time kept), in one transaction.
   void put(const StoredTransform& t);
-  /// Stores them all in one transaction: every one or none (each checked first).
-  void put(const std::vector<StoredTransform>& all);
+  /// Stores them all in one transaction: every one or none (each checked first). When
+  /// `cancelled` is given and says true just before the commit (Ctrl-C during a long import),
+  /// the transaction is rolled back and PutCancelled thrown: nothing is stored.
+  void put(const std::vector<StoredTransform>& all,
+           const std::function<bool()>& cancelled = {});
   /// Removes it; false when there was none.
   bool remove(std::string_view robot, std::string_view name);
   /// The robots that have transforms stored, by name.
