@@ -20,9 +20,18 @@ int run(int argc, char** argv) {
   CLI::App app{
       "rccx - robot programming and real-time control in the manner of RCCL/RTC (1986).\n"
       "Units are SI (m, rad, s) unless an option says otherwise. Exit codes: 0 done, 1 failed "
-      "while running, 2 bad input, 3 pose out of reach, 130 / 143 ended by SIGINT / SIGTERM."};
+      "while running, 2 bad input, 3 pose out of reach, 130 / 143 ended by SIGINT / SIGTERM.",
+      "rccx"};
   app.set_version_flag("--version", "rccx 0.1.0");
   app.require_subcommand(1);
+  // One wording for every bad argument, CLI11's own included (docs/RELIABILITY.md).
+  app.failure_message([](const CLI::App* from, const CLI::Error& e) {
+    std::string path;
+    for (const CLI::App* a = from; a != nullptr; a = a->get_parent()) {
+      path = a->get_name() + (path.empty() ? "" : " ") + path;
+    }
+    return fmt::format("error: {}\nRun `{} --help` for the options.\n", e.what(), path);
+  });
   int exit_code = rccx::tools::kOk;
   rccx::tools::add_kin_command(app, exit_code);
   rccx::tools::add_rtc_commands(app, exit_code);

@@ -340,9 +340,10 @@ void PositionDb::put(const std::vector<StoredTransform>& all,
   Transaction tr({db_, path_, busy_timeout_});
   for (const StoredTransform& t : all) insert(t);
   if (cancelled && cancelled()) {
-    throw PutCancelled(fmt::format("position database {}: stopped before the commit; nothing "
-                                   "stored",
-                                   path_.string()));  // the Transaction rolls back
+    throw PutCancelled(
+        fmt::format("position database {}: stopped before the commit; nothing "
+                    "stored",
+                    path_.string()));  // the Transaction rolls back
   }
   tr.commit();
 }

@@ -101,8 +101,7 @@ class PositionDb {
   /// Stores them all in one transaction: every one or none (each checked first). When
   /// `cancelled` is given and says true just before the commit (Ctrl-C during a long import),
   /// the transaction is rolled back and PutCancelled thrown: nothing is stored.
-  void put(const std::vector<StoredTransform>& all,
-           const std::function<bool()>& cancelled = {});
+  void put(const std::vector<StoredTransform>& all, const std::function<bool()>& cancelled = {});
   /// Removes it; false when there was none.
   bool remove(std::string_view robot, std::string_view name);
   /// The robots that have transforms stored, by name.
