@@ -42,6 +42,7 @@ unit-tests: build-debug
 # libFuzzer targets of every parser of outside input (clang), each on its corpus in fuzz/corpus.
 fuzz: deps
 	CC=clang CXX=clang++ $(CMAKE) -S . -B $(FUZZ_DIR) -DCMAKE_BUILD_TYPE=Debug -DRCCX_FUZZ=ON \
+	  -DCMAKE_C_FLAGS_DEBUG="-g -O1" -DCMAKE_CXX_FLAGS_DEBUG="-g -O1" \
 	  -DRCCX_BUILD_TESTS=OFF -DRCCX_BUILD_BENCHMARKS=OFF
 	$(CMAKE) --build $(FUZZ_DIR) -j$(JOBS) --target fuzz_targets
 	scripts/fuzz --build $(FUZZ_DIR) --seconds $(FUZZ_SECONDS)
