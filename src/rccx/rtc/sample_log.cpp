@@ -28,13 +28,22 @@ SampleLog::SampleLog(const std::filesystem::path& file, const kin::RobotModel& m
 }
 
 std::unique_ptr<SampleLog> SampleLog::from_environment(const kin::RobotModel& model) {
-  const char* file = std::getenv("RCCX_LOG");
-  if (file == nullptr || *file == '\0') return nullptr;
+  return from_environment(model, {});
+}
+
+std::unique_ptr<SampleLog> SampleLog::from_environment(const kin::RobotModel& model,
+                                                       std::string_view suffix) {
+  const char* value = std::getenv("RCCX_LOG");
+  if (value == nullptr || *value == '\0') return nullptr;
+  std::filesystem::path file(value);
+  if (!suffix.empty()) {
+    file.replace_filename(file.stem().string() + std::string(suffix) + file.extension().string());
+  }
   try {
     return std::make_unique<SampleLog>(file, model);
   } catch (const LogError& e) {
     throw LogError(fmt::format("RCCX_LOG={}: {} (unset RCCX_LOG or name a file you can write)",
-                               file, e.what()));
+                               value, e.what()));
   }
 }
 

@@ -47,6 +47,9 @@ class SampleLog {
   SampleLog(const std::filesystem::path& file, const kin::RobotModel& model);
   /// The log the environment asks for (RCCX_LOG=FILE), or nullptr; its errors name RCCX_LOG.
   static std::unique_ptr<SampleLog> from_environment(const kin::RobotModel& model);
+  /// The same for one robot of several: RCCX_LOG=cell.csv gives cell<suffix>.csv.
+  static std::unique_ptr<SampleLog> from_environment(const kin::RobotModel& model,
+                                                     std::string_view suffix);
   /// Writes what is queued and puts the file in place. Empty when the log is complete, else
   /// what went wrong (rows dropped, a write that failed: the target is then left as it was).
   /// Only the first call does anything.

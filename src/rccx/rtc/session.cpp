@@ -14,6 +14,7 @@
 #include <mutex>
 #include <utility>
 
+#include "rccx/io/console.hpp"
 #include "rccx/kinematics/kinematics.hpp"
 #include "rccx/rtc/hangup.hpp"
 #include "rccx/rtc/sync.hpp"
@@ -67,10 +68,10 @@ void try_real_time_scheduling(std::thread& t, int priority) {
   static std::atomic<bool> told{false};
   const auto tell = [](const char* what, int err) {
     if (!told.exchange(true)) {
-      fmt::print(stderr,
-                 "rtc: {} not permitted ({}): timing is best effort. Run as root or grant "
-                 "CAP_SYS_NICE / an rtprio limit for real-time scheduling.\n",
-                 what, std::strerror(err));
+      io::eprint(
+          "rtc: {} not permitted ({}): timing is best effort. Run as root or grant "
+          "CAP_SYS_NICE / an rtprio limit for real-time scheduling.\n",
+          what, std::strerror(err));
     }
   };
   std::call_once(locked, [&] {
@@ -91,53 +92,89 @@ void try_real_time_scheduling(std::thread& t, int priority) {
 
 }  // namespace
 
-struct Session::Shared {
+// The clock of one session, or of a group: the time, the two tasks, and the hand-overs of
+// figure 4.7, one set per tick for every robot due at it.
+struct Session::Clock {
+  SessionOptions options;
+  std::atomic<std::int64_t> period_ns{0};
+  std::int64_t t0_ns = 0;  ///< real time: the monotonic time the clock started
+
   // Doorbells: each party sleeps on its own, the others ring it after changing what it watches.
   detail::Doorbell comm_bell;
   detail::Doorbell control_bell;
   mutable detail::Doorbell planning_bell;
 
-  // Sample numbers (the first sample is 1; 0 is "none"), one counter per hand-over of figure 4.7.
+  // Tick numbers (the first tick is 1; 0 is "none"), one counter per hand-over of figure 4.7.
   std::atomic<std::uint32_t> granted{0};       ///< simulated time: ticks the planning level let run
-  std::atomic<std::uint32_t> how_ready{0};     ///< comm -> control: How of this sample is in `how`
-  std::atomic<std::uint32_t> chg_ready{0};     ///< control -> comm: Chg after f1 is in `chg`
-  std::atomic<std::uint32_t> chg_taken{0};     ///< comm -> control: Chg copied, control may go on
-  std::atomic<std::uint32_t> control_done{0};  ///< control finished f2: the watchdog kick
+  std::atomic<std::uint32_t> how_ready{0};     ///< comm -> control: How of this tick handed over
+  std::atomic<std::uint32_t> chg_ready{0};     ///< control -> comm: Chg after every f1 is there
+  std::atomic<std::uint32_t> chg_taken{0};     ///< comm -> control: Chg copied, control goes on
+  std::atomic<std::uint32_t> control_done{0};  ///< control finished every f2: the watchdog kick
   std::atomic<std::uint32_t> comm_done{0};     ///< comm finished its cycle
+  std::atomic<std::int64_t> handed_tick_ns{0};  ///< clock time of the tick handed to control
+  std::atomic<std::int64_t> control_end_ns{0};  ///< clock time the last control cycle ended
+  std::atomic<std::int64_t> simulated_now_ns{0};
+  std::atomic<bool> control_busy{false};
+  std::atomic<bool> stop{false};
+  LatencyHistogram latency;
+
+  std::vector<Session*> sessions;  ///< fixed once the tasks run
+  std::thread communication_thread;
+  std::thread control_thread;
+  bool running = false;
+  bool stopped = false;
+
+  // Planning side: one thread at a time steps simulated time.
+  std::mutex step_mutex;
+  std::uint32_t simulated_ticks = 0;
+
+  // The communication task's own.
+  std::uint32_t last_published = 0;  ///< last tick handed to control
+  std::int64_t last_published_tick_ns = 0;
+
+  [[nodiscard]] bool simulated() const noexcept { return options.clock == ClockKind::simulated; }
+  [[nodiscard]] std::int64_t now_ns() const noexcept {
+    return simulated() ? simulated_now_ns.load() : monotonic_ns() - t0_ns;
+  }
+
+  void start();
+  void stop_tasks();
+  void communication_task() noexcept;
+  bool wait_tick(std::uint32_t k, std::int64_t& next_deadline, std::int64_t& tick_ns) noexcept;
+  void watchdog(std::uint32_t k, std::int64_t tick_ns) noexcept;
+  void control_task() noexcept;
+  void control_cycle(std::uint32_t k) noexcept;
+  void step_simulated_sample();
+};
+
+// One robot's side: what the planning level, the communication task and the control task
+// exchange for it.
+struct Session::Shared {
   std::atomic<std::uint32_t> phase{kIdle};
   std::atomic<std::uint32_t> generation{0};  ///< bumped by control(): comm resets its state
   std::atomic<std::uint32_t> pending{0};
-  std::atomic<bool> control_busy{false};
-  std::atomic<bool> stop{false};
+  std::atomic<std::uint32_t> in_cycle{0};  ///< the tick whose control cycle includes this robot
   std::atomic<bool> user_hangup{false};
   std::atomic<std::int32_t> requested_code{0};
   std::atomic<std::int32_t> requested_joint{0};
-  std::atomic<std::int64_t> control_end_ns{0};  ///< session time the last control cycle ended
-  std::atomic<std::int64_t> simulated_now_ns{0};
-  std::atomic<std::int64_t> period_ns{0};
-  std::int64_t t0_ns = 0;  ///< real time: the monotonic time the session opened
   std::atomic<SampleLog*> log{nullptr};
 
-  How how;                  ///< guarded by how_ready / the next tick
-  Chg chg;                  ///< guarded by chg_ready / chg_taken
+  How how;                  ///< guarded by the clock's how_ready / the next tick
+  Chg chg;                  ///< guarded by the clock's chg_ready / chg_taken
   Termination termination;  ///< written while kEnding, read once kEnded
   Control control;          ///< the control task's own
   mutable detail::Latest<How> latest;
-  LatencyHistogram latency;
 
   mutable std::mutex snapshot_mutex;  ///< planning side only
   mutable How snapshot;
 };
 
 struct Session::CommState {
-  std::uint32_t k = 0;
-  std::int64_t tick_ns = 0;        ///< session time of this tick
-  std::int64_t next_deadline = 0;  ///< real time: monotonic ns of the next tick
   How how;
   Chg chg;
+  std::uint32_t k = 0;
+  std::int64_t tick_ns = 0;
   std::uint32_t generation = 0;
-  std::uint32_t last_published = 0;  ///< last sample handed to control in this session
-  std::int64_t last_published_tick_ns = 0;
   std::uint32_t hangups_seen = 0;
   bool power_expected = false;
   bool ended = false;
@@ -157,7 +194,7 @@ void Control::message(std::string_view text) noexcept {
 }
 
 void Control::spend(std::chrono::nanoseconds d) noexcept {
-  if (session_->options_.clock == ClockKind::simulated) {
+  if (session_->clock_->simulated()) {
     spent_ns_ += d.count();
     return;
   }
@@ -170,29 +207,35 @@ void Control::spend(std::chrono::nanoseconds d) noexcept {
 // Opening and closing
 
 Session::Session(Driver& driver, SessionOptions options)
-    : driver_(driver),
-      options_(options),
-      period_(options.period),
-      shared_(std::make_unique<Shared>()) {
+    : driver_(driver), clock_(std::make_shared<Clock>()), owns_clock_(true) {
+  clock_->options = options;
+  clock_->period_ns = options.period.count();
+  open_channel({});
+  clock_->sessions.push_back(this);
+  clock_->start();
+}
+
+Session::Session(Driver& driver, std::shared_ptr<Clock> clock, int multiple,
+                 std::string log_suffix)
+    : driver_(driver), clock_(std::move(clock)), multiple_(multiple) {
+  open_channel(log_suffix);
+}
+
+void Session::open_channel(const std::string& log_suffix) {
   if (driver_.model().dof() == 0 || driver_.model().dof() > kMaxJoints) {
     throw SessionError(fmt::format("robot {} has {} joints; RTC serves 1 to {}",
                                    driver_.model().name, driver_.model().dof(), kMaxJoints));
   }
-  check_period(period_);
-  Shared& s = *shared_;
-  s.period_ns = period_.count();
-  s.t0_ns = monotonic_ns();
-  environment_log_ = SampleLog::from_environment(driver_.model());  // LogError names RCCX_LOG
-  s.log = environment_log_.get();
-  s.control.session_ = this;
-  communication_thread_ = std::thread([this] { communication_task(); });
-  control_thread_ = std::thread([this] { control_task(); });
-  if (options_.clock == ClockKind::real_time && options_.real_time_scheduling) {
-    try_real_time_scheduling(communication_thread_, 80);
-    try_real_time_scheduling(control_thread_, 79);
+  check_period(period());
+  shared_ = std::make_unique<Shared>();
+  comm_ = std::make_unique<CommState>();
+  if (log_suffix.empty()) {
+    environment_log_ = SampleLog::from_environment(driver_.model());  // LogError names RCCX_LOG
+  } else {
+    environment_log_ = SampleLog::from_environment(driver_.model(), log_suffix);
   }
-  // The first How, so that how() means something before the first wait.
-  if (options_.clock == ClockKind::simulated) step_simulated_sample();
+  shared_->log = environment_log_.get();
+  shared_->control.session_ = this;
 }
 
 Session::~Session() {
@@ -200,6 +243,18 @@ Session::~Session() {
     close();
   } catch (...) {  // close() only throws for misuse that a destructor cannot report
   }
+}
+
+std::chrono::nanoseconds Session::period() const noexcept {
+  return std::chrono::nanoseconds(clock_->period_ns.load() * multiple_);
+}
+
+ClockKind Session::clock() const noexcept {
+  return clock_->options.clock;
+}
+
+bool Session::due(std::uint32_t k) const noexcept {
+  return multiple_ == 1 || (k - 1) % static_cast<std::uint32_t>(multiple_) == 0;
 }
 
 void Session::check_period(std::chrono::nanoseconds p) const {
@@ -219,23 +274,100 @@ void Session::check_period(std::chrono::nanoseconds p) const {
 }
 
 void Session::set_period(std::chrono::nanoseconds period) {
+  if (!owns_clock_) {
+    throw SessionError("a robot of a group keeps the group's clock; its period cannot change");
+  }
   check_period(period);
   if (controlling()) throw SessionError("the sample period can change only while not in control");
-  period_ = period;
-  shared_->period_ns = period.count();
+  clock_->period_ns = period.count();
 }
 
 void Session::close(bool power_off) {
   if (closed_) return;
   release(power_off);
-  Shared& s = *shared_;
-  s.stop.store(true, std::memory_order_seq_cst);
-  ring(s.comm_bell);
-  ring(s.control_bell);
-  communication_thread_.join();
-  control_thread_.join();
+  if (owns_clock_) clock_->stop_tasks();
   closed_ = true;
   if (environment_log_) log_problem_ = environment_log_->close();
+}
+
+void Session::Clock::start() {
+  if (running) return;
+  t0_ns = monotonic_ns();
+  running = true;
+  communication_thread = std::thread([this] { communication_task(); });
+  control_thread = std::thread([this] { control_task(); });
+  if (options.clock == ClockKind::real_time && options.real_time_scheduling) {
+    try_real_time_scheduling(communication_thread, 80);
+    try_real_time_scheduling(control_thread, 79);
+  }
+  // The first How, so that how() means something before the first wait.
+  if (simulated()) step_simulated_sample();
+}
+
+void Session::Clock::stop_tasks() {
+  if (!running || stopped) return;
+  stop.store(true, std::memory_order_seq_cst);
+  ring(comm_bell);
+  ring(control_bell);
+  communication_thread.join();
+  control_thread.join();
+  stopped = true;
+}
+
+// ---------------------------------------------------------------------------------------------
+// A group
+
+SessionGroup::SessionGroup(SessionOptions options) : clock_(std::make_shared<Session::Clock>()) {
+  if (options.period < kMinPeriod || options.period > kMaxPeriod) {
+    using ms = std::chrono::duration<double, std::milli>;
+    throw SessionError(fmt::format("the clock's period {} ms is outside {} .. {} ms",
+                                   ms(options.period).count(), ms(kMinPeriod).count(),
+                                   ms(kMaxPeriod).count()));
+  }
+  clock_->options = options;
+  clock_->period_ns = options.period.count();
+}
+
+SessionGroup::~SessionGroup() {
+  for (auto& s : sessions_) {
+    try {
+      s->release();
+    } catch (...) {
+    }
+  }
+  clock_->stop_tasks();
+  sessions_.clear();  // their logs close after the tasks have stopped
+}
+
+Session& SessionGroup::add(Driver& driver, int multiple) {
+  if (clock_->running) throw SessionError("add every robot before start()");
+  if (multiple < 1 || multiple > 1000) {
+    throw SessionError(fmt::format("robot {}: a period multiple of {}; give 1 to 1000",
+                                   driver.model().name, multiple));
+  }
+  auto s = std::unique_ptr<Session>(
+      new Session(driver, clock_, multiple, "-" + driver.model().name));
+  clock_->sessions.push_back(s.get());
+  sessions_.push_back(std::move(s));
+  return *sessions_.back();
+}
+
+void SessionGroup::start() {
+  if (sessions_.empty()) throw SessionError("a group needs at least one robot: add() it first");
+  clock_->start();
+}
+
+std::chrono::nanoseconds SessionGroup::period() const noexcept {
+  return std::chrono::nanoseconds(clock_->period_ns.load());
+}
+
+LatencyStats SessionGroup::latency() const {
+  return clock_->latency.stats();
+}
+
+void SessionGroup::wait_for(std::chrono::nanoseconds d) {
+  if (sessions_.empty() || !clock_->running) throw SessionError("start() the group first");
+  sessions_.front()->wait_for(d);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -243,6 +375,7 @@ void Session::close(bool power_off) {
 
 void Session::control(ControlFunction f1, ControlFunction f2) {
   if (closed_) throw SessionError("the session is closed; open a new one");
+  if (!clock_->running) throw SessionError("the group is not started: call start() first");
   Shared& s = *shared_;
   const std::uint32_t p = s.phase.load(std::memory_order_acquire);
   if (p == kControlling) throw SessionError("control is already active: release() it first");
@@ -261,11 +394,12 @@ void Session::control(ControlFunction f1, ControlFunction f2) {
   s.generation.fetch_add(1, std::memory_order_relaxed);
   detail::register_for_hangup(this);
   s.phase.store(kControlling, std::memory_order_seq_cst);
-  ring(s.comm_bell);
+  ring(clock_->comm_bell);
 }
 
 Termination Session::release(bool power_off) {
   Shared& s = *shared_;
+  Clock& clk = *clock_;
   bool ended = false;
   for (;;) {
     std::uint32_t p = s.phase.load(std::memory_order_seq_cst);
@@ -280,8 +414,8 @@ Termination Session::release(bool power_off) {
     }
     std::this_thread::yield();  // kEnding: the communication task is writing the termination
   }
-  ring(s.control_bell);
-  ring(s.comm_bell);
+  ring(clk.control_bell);
+  ring(clk.comm_bell);
   Termination t = ended ? ended_termination() : Termination{};
   if (!ended) {
     wait_control_idle();
@@ -289,18 +423,19 @@ Termination Session::release(bool power_off) {
   }
   s.phase.store(kIdle, std::memory_order_seq_cst);
   detail::unregister_for_hangup(this);
+  if (!clk.running || clk.stopped) return t;
 
   // The arm holds where it is (and powers off if asked) from the next tick on.
   s.pending.fetch_or(kPendingHold | (power_off ? kPendingPowerOff : 0U));
-  if (options_.clock == ClockKind::simulated) {
-    step_simulated_sample();
+  if (clk.simulated()) {
+    clk.step_simulated_sample();
   } else {
-    const std::uint32_t before = s.comm_done.load(std::memory_order_acquire);
-    const std::int64_t deadline = monotonic_ns() + 4 * period_.count();
-    while (s.comm_done.load(std::memory_order_acquire) == before && monotonic_ns() < deadline) {
-      const std::uint32_t seen = s.planning_bell.load();
-      if (s.comm_done.load(std::memory_order_acquire) != before) break;
-      wait_while(s.planning_bell, seen, deadline);
+    const std::uint32_t before = clk.comm_done.load(std::memory_order_acquire);
+    const std::int64_t deadline = monotonic_ns() + 4 * clk.period_ns.load();
+    while (clk.comm_done.load(std::memory_order_acquire) == before && monotonic_ns() < deadline) {
+      const std::uint32_t seen = clk.planning_bell.load();
+      if (clk.comm_done.load(std::memory_order_acquire) != before) break;
+      wait_while(clk.planning_bell, seen, deadline);
     }
   }
   return t;
@@ -323,11 +458,11 @@ bool Session::controlling() const noexcept {
 }
 
 void Session::wait_control_idle() const {
-  const Shared& s = *shared_;
-  while (s.control_busy.load(std::memory_order_seq_cst)) {
-    const std::uint32_t seen = s.planning_bell.load();
-    if (!s.control_busy.load(std::memory_order_seq_cst)) break;
-    wait_while(s.planning_bell, seen, monotonic_ns() + 1'000'000);
+  const Clock& clk = *clock_;
+  while (clk.control_busy.load(std::memory_order_seq_cst)) {
+    const std::uint32_t seen = clk.planning_bell.load();
+    if (!clk.control_busy.load(std::memory_order_seq_cst)) break;
+    wait_while(clk.planning_bell, seen, monotonic_ns() + 1'000'000);
   }
 }
 
@@ -351,7 +486,7 @@ How Session::how() const {
 }
 
 LatencyStats Session::latency() const {
-  return shared_->latency.stats();
+  return clock_->latency.stats();
 }
 
 void Session::set_log(SampleLog* log) {
@@ -368,46 +503,49 @@ void Session::hangup() {
   if (hangup_handler_ && controlling()) hangup_handler_(*this);
 }
 
-void Session::step_simulated_sample() {
-  Shared& s = *shared_;
-  const std::uint32_t k = ++simulated_ticks_;
-  s.simulated_now_ns.fetch_add(period_.count(), std::memory_order_relaxed);
-  s.granted.store(k, std::memory_order_release);
-  ring(s.comm_bell);
+void Session::Clock::step_simulated_sample() {
+  std::lock_guard lock(step_mutex);
+  const std::uint32_t k = ++simulated_ticks;
+  simulated_now_ns.fetch_add(period_ns.load(), std::memory_order_relaxed);
+  granted.store(k, std::memory_order_release);
+  ring(comm_bell);
   const auto wait_for_counter = [&](const std::atomic<std::uint32_t>& counter,
                                     std::int64_t deadline) {
     for (;;) {
-      const std::uint32_t seen = s.planning_bell.load();
+      const std::uint32_t seen = planning_bell.load();
       if (reached(counter.load(std::memory_order_acquire), k)) return true;
       if (deadline > 0 && monotonic_ns() >= deadline) return false;
       // No spinning: the two tasks need both processors for the sample this thread waits for.
-      wait_while(s.planning_bell, seen, deadline, 0);
+      wait_while(planning_bell, seen, deadline, 0);
     }
   };
-  wait_for_counter(s.comm_done, 0);
-  // When the communication task handed this sample to the control task, the sample is over
-  // only when the control cycle is: that keeps simulated time deterministic. A control cycle
-  // that hangs is left behind; the watchdog ends the session at the next tick.
-  if (s.how_ready.load(std::memory_order_acquire) == k) {
-    wait_for_counter(s.control_done, monotonic_ns() + options_.hang_timeout.count() * 1'000'000);
+  wait_for_counter(comm_done, 0);
+  // When the communication task handed this tick to the control task, the tick is over only
+  // when the control cycle is: that keeps simulated time deterministic. A control cycle that
+  // hangs is left behind; the watchdog ends the session at the next tick.
+  if (how_ready.load(std::memory_order_acquire) == k) {
+    wait_for_counter(control_done, monotonic_ns() + options.hang_timeout.count() * 1'000'000);
   }
 }
 
 Termination Session::wait_for(std::chrono::nanoseconds d) {
   // A stop signal (Ctrl-C, SIGTERM) ends the wait within a period, whatever its length.
+  Clock& clk = *clock_;
   const std::uint32_t stops = detail::hangup_count();
   const auto stopped = [&] { return detail::hangup_count() != stops; };
-  if (options_.clock == ClockKind::simulated) {
-    const std::int64_t until = shared_->simulated_now_ns.load() + d.count();
-    while (!stopped() && shared_->simulated_now_ns.load() + period_.count() <= until) {
-      step_simulated_sample();
+  if (clk.simulated()) {
+    const std::int64_t until = clk.simulated_now_ns.load() + d.count();
+    while (!stopped() && clk.simulated_now_ns.load() + clk.period_ns.load() <= until) {
+      clk.step_simulated_sample();
     }
-    // One more sample lets the communication task see the signal and end control.
-    if (stopped() && controlling()) step_simulated_sample();
+    // One more tick lets the communication task see the signal and end control.
+    if (stopped() && controlling()) {
+      for (int i = 0; i < multiple_ && controlling(); ++i) clk.step_simulated_sample();
+    }
   } else {
     const std::int64_t until = monotonic_ns() + d.count();
     for (std::int64_t now = monotonic_ns(); now < until && !stopped(); now = monotonic_ns()) {
-      detail::sleep_until(std::min(until, now + period_.count()));
+      detail::sleep_until(std::min(until, now + clk.period_ns.load()));
     }
   }
   return termination();
@@ -415,20 +553,22 @@ Termination Session::wait_for(std::chrono::nanoseconds d) {
 
 Termination Session::wait_terminated(std::chrono::nanoseconds timeout) {
   Shared& s = *shared_;
+  Clock& clk = *clock_;
   const std::uint32_t stops = detail::hangup_count();
   const auto ended = [&] {
     return s.phase.load(std::memory_order_seq_cst) == kEnded || detail::hangup_count() != stops;
   };
-  if (options_.clock == ClockKind::simulated) {
-    const std::int64_t until = s.simulated_now_ns.load() + timeout.count();
-    while (!ended() && s.simulated_now_ns.load() + period_.count() <= until)
-      step_simulated_sample();
+  if (clk.simulated()) {
+    const std::int64_t until = clk.simulated_now_ns.load() + timeout.count();
+    while (!ended() && clk.simulated_now_ns.load() + clk.period_ns.load() <= until) {
+      clk.step_simulated_sample();
+    }
   } else {
     const std::int64_t deadline = monotonic_ns() + timeout.count();
     while (!ended() && monotonic_ns() < deadline) {
-      const std::uint32_t seen = s.planning_bell.load();
+      const std::uint32_t seen = clk.planning_bell.load();
       if (ended()) break;
-      wait_while(s.planning_bell, seen, std::min(deadline, monotonic_ns() + period_.count()));
+      wait_while(clk.planning_bell, seen, std::min(deadline, monotonic_ns() + period().count()));
     }
   }
   return termination();
@@ -437,19 +577,26 @@ Termination Session::wait_terminated(std::chrono::nanoseconds timeout) {
 bool Session::wait_until(const std::function<bool(const How&)>& done,
                          std::chrono::nanoseconds timeout) {
   Shared& s = *shared_;
-  const bool simulated = options_.clock == ClockKind::simulated;
-  const std::int64_t start = simulated ? s.simulated_now_ns.load() : monotonic_ns();
+  Clock& clk = *clock_;
+  const bool simulated = clk.simulated();
+  const std::int64_t start = simulated ? clk.simulated_now_ns.load() : monotonic_ns();
   const std::uint32_t stops = detail::hangup_count();
+  std::uint64_t seen_sample = ~std::uint64_t{0};
   for (;;) {
-    if (done(how())) return true;
+    // A robot sampled every k-th tick has a new How only every k-th tick.
+    const How h = how();
+    if (h.sample != seen_sample) {
+      seen_sample = h.sample;
+      if (done(h)) return true;
+    }
     if (s.phase.load(std::memory_order_seq_cst) == kEnded) return false;
     if (detail::hangup_count() != stops) return false;  // Ctrl-C, SIGTERM
-    const std::int64_t now = simulated ? s.simulated_now_ns.load() : monotonic_ns();
+    const std::int64_t now = simulated ? clk.simulated_now_ns.load() : monotonic_ns();
     if (now - start >= timeout.count()) return false;
     if (simulated) {
-      step_simulated_sample();
+      clk.step_simulated_sample();
     } else {
-      detail::sleep_until(monotonic_ns() + period_.count());
+      detail::sleep_until(monotonic_ns() + clk.period_ns.load());
     }
   }
 }
@@ -457,16 +604,58 @@ bool Session::wait_until(const std::function<bool(const How&)>& done,
 // ---------------------------------------------------------------------------------------------
 // The communication task
 
-void Session::communication_task() noexcept {
-  Shared& s = *shared_;
-  CommState c;
-  c.next_deadline = s.t0_ns + s.period_ns.load();
-  for (;;) {
-    ++c.k;
-    if (!wait_tick(c)) return;
-    communication_cycle(c);
-    s.comm_done.store(c.k, std::memory_order_release);
-    ring(s.planning_bell);
+void Session::Clock::communication_task() noexcept {
+  std::int64_t next_deadline = t0_ns + period_ns.load();
+  for (std::uint32_t k = 1;; ++k) {
+    std::int64_t tick_ns = 0;
+    if (!wait_tick(k, next_deadline, tick_ns)) return;
+    watchdog(k, tick_ns);
+
+    bool handed = false;
+    for (Session* s : sessions) {
+      if (s->communication_cycle(*s->comm_, k, tick_ns)) handed = true;
+    }
+    if (handed) {
+      // Hand How over for every robot at once; wait for the Chg their f1s leave (at most until
+      // the next tick).
+      handed_tick_ns.store(tick_ns, std::memory_order_relaxed);
+      how_ready.store(k, std::memory_order_release);
+      ring(control_bell);
+      last_published = k;
+      last_published_tick_ns = tick_ns;
+      const std::int64_t deadline = options.clock == ClockKind::real_time
+                                        ? next_deadline
+                                        : monotonic_ns() + options.hang_timeout.count() * 1'000'000;
+      bool in_time = true;
+      for (;;) {
+        const std::uint32_t seen = comm_bell.load();
+        if (reached(chg_ready.load(std::memory_order_acquire), k)) break;
+        if (stop.load(std::memory_order_acquire)) return;
+        if (monotonic_ns() >= deadline) {
+          in_time = false;
+          break;
+        }
+        wait_while(comm_bell, seen, deadline);
+      }
+      for (Session* s : sessions) {
+        if (s->shared_->in_cycle.load(std::memory_order_relaxed) != k) continue;
+        if (!s->comm_->ended &&
+            s->shared_->phase.load(std::memory_order_seq_cst) == kControlling) {
+          if (in_time) {
+            s->take_chg(*s->comm_);
+          } else {
+            std::array<char, kMessageCapacity> d;
+            format_text(d, "f1 of sample {} did not hand Chg over within its period", k);
+            s->end_control(*s->comm_, TerminateCode::overrun, 0, d.data());
+          }
+        }
+        s->shared_->latest.publish(s->comm_->how);  // with the flags the Chg set
+      }
+      chg_taken.store(k, std::memory_order_release);
+      ring(control_bell);
+    }
+    comm_done.store(k, std::memory_order_release);
+    ring(planning_bell);
   }
 }
 
@@ -474,103 +663,121 @@ void Session::communication_task() noexcept {
 // keep the processor it needs busy.
 constexpr int kSpinsForGrant = 0;
 
-bool Session::wait_tick(CommState& c) noexcept {
-  Shared& s = *shared_;
-  if (options_.clock == ClockKind::simulated) {
+bool Session::Clock::wait_tick(std::uint32_t k, std::int64_t& next_deadline,
+                               std::int64_t& tick_ns) noexcept {
+  if (simulated()) {
     for (;;) {
-      const std::uint32_t seen = s.comm_bell.load();
-      if (s.stop.load(std::memory_order_acquire)) return false;
-      if (reached(s.granted.load(std::memory_order_acquire), c.k)) break;
-      wait_while(s.comm_bell, seen, 0, kSpinsForGrant);
+      const std::uint32_t seen = comm_bell.load();
+      if (stop.load(std::memory_order_acquire)) return false;
+      if (reached(granted.load(std::memory_order_acquire), k)) break;
+      wait_while(comm_bell, seen, 0, kSpinsForGrant);
     }
-    c.tick_ns = s.simulated_now_ns.load(std::memory_order_relaxed);
+    tick_ns = simulated_now_ns.load(std::memory_order_relaxed);
     return true;
   }
-  const std::int64_t deadline = c.next_deadline;
+  const std::int64_t deadline = next_deadline;
   detail::sleep_until(deadline);
-  if (s.stop.load(std::memory_order_acquire)) return false;
-  const std::int64_t period = s.period_ns.load(std::memory_order_relaxed);
+  if (stop.load(std::memory_order_acquire)) return false;
+  const std::int64_t period = period_ns.load(std::memory_order_relaxed);
   const std::int64_t late = monotonic_ns() - deadline;
-  if (options_.measure_latency) s.latency.record(late);
+  if (options.measure_latency) latency.record(late);
   // A wake-up more than a period late has missed ticks: skip them rather than run a burst.
   const std::int64_t missed = late / period;
-  if (missed > 0) s.latency.record_missed(static_cast<std::uint64_t>(missed));
-  c.next_deadline = deadline + (missed + 1) * period;
-  c.tick_ns = deadline - s.t0_ns;
+  if (missed > 0) latency.record_missed(static_cast<std::uint64_t>(missed));
+  next_deadline = deadline + (missed + 1) * period;
+  tick_ns = deadline - t0_ns;
   return true;
 }
 
-void Session::communication_cycle(CommState& c) noexcept {
+// The watchdog: the control cycle of the last tick must have finished within its period; when
+// it did not, every robot whose functions ran in it ends with `overrun`.
+void Session::Clock::watchdog(std::uint32_t k, std::int64_t tick_ns) noexcept {
+  if (last_published == 0) return;
+  const std::uint32_t cycle = last_published;
+  last_published = 0;
+  std::array<char, kMessageCapacity> d{};
+  if (control_done.load(std::memory_order_acquire) != cycle) {
+    format_text(d, "the control cycle of sample {} was still running at the next tick", cycle);
+  } else if (simulated()) {
+    // Simulated time: the computing a cycle charged with spend() must fit in its period. (In
+    // real time the check above is the whole story: the cycle finished before this tick was
+    // processed, so its Chg was in time.)
+    const std::int64_t period = period_ns.load(std::memory_order_relaxed);
+    const std::int64_t used = control_end_ns.load(std::memory_order_relaxed) - last_published_tick_ns;
+    if (used <= period) return;
+    format_text(d, "the control cycle of sample {} took {:.3f} ms of a {:.3f} ms period", cycle,
+                static_cast<double>(used) * 1e-6, static_cast<double>(period) * 1e-6);
+  } else {
+    return;
+  }
+  for (Session* s : sessions) {
+    if (s->shared_->in_cycle.load(std::memory_order_relaxed) != cycle) continue;
+    if (s->comm_->ended || s->shared_->phase.load(std::memory_order_seq_cst) != kControlling) {
+      continue;
+    }
+    s->comm_->k = k;  // found at this tick
+    s->comm_->tick_ns = tick_ns;
+    s->end_control(*s->comm_, TerminateCode::overrun, 0, d.data());
+  }
+}
+
+bool Session::communication_cycle(CommState& c, std::uint32_t k, std::int64_t tick_ns) noexcept {
   Shared& s = *shared_;
+  // Requests from release() are carried out at the next tick, whether or not the robot is due.
+  const std::uint32_t pending = s.pending.exchange(0, std::memory_order_acq_rel);
+  if ((pending & kPendingHold) != 0) driver_.hold();
+  if ((pending & kPendingPowerOff) != 0) driver_.set_power(false);
+  if (!due(k)) return false;
+
   How& h = c.how;
-  const double t = static_cast<double>(c.tick_ns) * 1e-9;
+  c.k = k;
+  c.tick_ns = tick_ns;
+  const double t = static_cast<double>(tick_ns) * 1e-9;
   driver_.read(t, h);
-  h.sample = c.k;
+  h.sample = k;
   h.time_s = t;
   const auto& joints = driver_.model().joints;
   for (std::size_t i = 0; i < h.dof; ++i) h.joint[i].range = h.joint[i].q - joints[i].lower;
 
-  const std::uint32_t pending = s.pending.exchange(0, std::memory_order_acq_rel);
-  if ((pending & kPendingHold) != 0) driver_.hold();
-  if ((pending & kPendingPowerOff) != 0) driver_.set_power(false);
-
-  if (s.phase.load(std::memory_order_seq_cst) == kControlling) controlled_cycle(c);
-  s.latest.publish(h);
+  bool handed = false;
+  if (s.phase.load(std::memory_order_seq_cst) == kControlling) handed = controlled_cycle(c, k);
+  if (!handed) s.latest.publish(h);  // a handed How is published once its Chg is applied
+  return handed;
 }
 
-void Session::controlled_cycle(CommState& c) noexcept {
+bool Session::controlled_cycle(CommState& c, std::uint32_t k) noexcept {
   Shared& s = *shared_;
   How& h = c.how;
   const auto& joints = driver_.model().joints;
-  const std::int64_t period = s.period_ns.load(std::memory_order_relaxed);
+  const std::int64_t period = this->period().count();
 
   const std::uint32_t generation = s.generation.load(std::memory_order_relaxed);
   if (generation != c.generation) {  // a new control session: start its state afresh
     c.generation = generation;
-    c.last_published = 0;
     c.hangups_seen = detail::hangup_count();
     c.power_expected = h.power;
     c.ended = false;
     c.chg = Chg{};
     c.has_target = {};
   }
-  if (c.ended) return;
-
-  // The watchdog: the control cycle of the last sample must have finished within its period.
-  if (c.last_published != 0) {
-    if (s.control_done.load(std::memory_order_acquire) != c.last_published) {
-      std::array<char, kMessageCapacity> d;
-      format_text(d, "the control cycle of sample {} was still running at the next tick",
-                  c.last_published);
-      return end_control(c, TerminateCode::overrun, 0, d.data());
-    }
-    // Simulated time: the computing a cycle charged with spend() must fit in its period. (In
-    // real time the check above is the whole story: the cycle finished before this tick was
-    // processed, so its Chg was in time.)
-    const std::int64_t used =
-        s.control_end_ns.load(std::memory_order_relaxed) - c.last_published_tick_ns;
-    if (options_.clock == ClockKind::simulated && used > period) {
-      std::array<char, kMessageCapacity> d;
-      format_text(d, "the control cycle of sample {} took {:.3f} ms of a {:.3f} ms period",
-                  c.last_published, static_cast<double>(used) * 1e-6,
-                  static_cast<double>(period) * 1e-6);
-      return end_control(c, TerminateCode::overrun, 0, d.data());
-    }
-  }
+  if (c.ended) return false;
 
   if (const std::int32_t code = s.requested_code.exchange(0); code != 0) {
-    return end_control(c, static_cast<TerminateCode>(code), s.requested_joint.load(), "");
+    end_control(c, static_cast<TerminateCode>(code), s.requested_joint.load(), "");
+    return false;
   }
   if (const std::uint32_t n = detail::hangup_count(); n != c.hangups_seen) {
     c.hangups_seen = n;
     if (!s.user_hangup.load(std::memory_order_relaxed)) {
-      return end_control(c, TerminateCode::user_interrupt, 0, "");
+      end_control(c, TerminateCode::user_interrupt, 0, "");
+      return false;
     }
   }
 
   // Power first: losing it makes every joint report a fault.
   if (c.power_expected && !h.power) {
-    return end_control(c, TerminateCode::power_failure, 0, "arm power went off");
+    end_control(c, TerminateCode::power_failure, 0, "arm power went off");
+    return false;
   }
   static constexpr std::pair<JointFlag, TerminateCode> kFaults[] = {
       {kNotAnswering, TerminateCode::joint_not_answering},
@@ -581,7 +788,8 @@ void Session::controlled_cycle(CommState& c) noexcept {
   for (std::size_t i = 0; i < h.dof; ++i) {
     for (const auto& [flag, code] : kFaults) {
       if (h.joint[i].has(flag)) {
-        return end_control(c, code, static_cast<int>(i) + 1, driver_.fault_detail(i));
+        end_control(c, code, static_cast<int>(i) + 1, driver_.fault_detail(i));
+        return false;
       }
     }
   }
@@ -600,7 +808,8 @@ void Session::controlled_cycle(CommState& c) noexcept {
         std::array<char, kMessageCapacity> d;
         format_text(d, "joint {} measured at {:.5f} {}, limits [{:.5f}, {:.5f}]", i + 1, j.q,
                     unit_of(m), m.lower, m.upper);
-        return end_control(c, TerminateCode::observed_position, static_cast<int>(i) + 1, d.data());
+        end_control(c, TerminateCode::observed_position, static_cast<int>(i) + 1, d.data());
+        return false;
       }
     }
     // Speeds come from encoder differences: allow their quantisation and a little overshoot.
@@ -612,36 +821,22 @@ void Session::controlled_cycle(CommState& c) noexcept {
         std::array<char, kMessageCapacity> d;
         format_text(d, "joint {} measured at {:.4f} {}/s, maximum {:.4f}", i + 1, j.velocity,
                     unit_of(m), top);
-        return end_control(c, TerminateCode::observed_velocity, static_cast<int>(i) + 1, d.data());
+        end_control(c, TerminateCode::observed_velocity, static_cast<int>(i) + 1, d.data());
+        return false;
       }
     }
   }
 
-  // Hand How over; wait for the Chg that f1 leaves (at most until the next tick).
+  // This robot's How for the control task; the clock hands every robot's over at once.
   s.how = h;
-  s.how_ready.store(c.k, std::memory_order_release);
-  ring(s.control_bell);
-  c.last_published = c.k;
-  c.last_published_tick_ns = c.tick_ns;
+  s.in_cycle.store(k, std::memory_order_relaxed);
+  return true;
+}
 
-  const std::int64_t deadline = options_.clock == ClockKind::real_time
-                                    ? c.next_deadline
-                                    : monotonic_ns() + options_.hang_timeout.count() * 1'000'000;
-  for (;;) {
-    const std::uint32_t seen = s.comm_bell.load();
-    if (reached(s.chg_ready.load(std::memory_order_acquire), c.k)) break;
-    if (s.phase.load(std::memory_order_seq_cst) != kControlling) return;  // released
-    if (s.stop.load(std::memory_order_acquire)) return;
-    if (monotonic_ns() >= deadline) {
-      std::array<char, kMessageCapacity> d;
-      format_text(d, "f1 of sample {} did not hand Chg over within its period", c.k);
-      return end_control(c, TerminateCode::overrun, 0, d.data());
-    }
-    wait_while(s.comm_bell, seen, deadline);
-  }
+void Session::take_chg(CommState& c) noexcept {
+  Shared& s = *shared_;
+  const How& h = c.how;
   c.chg = s.chg;
-  s.chg_taken.store(c.k, std::memory_order_release);
-  ring(s.control_bell);
   apply(c, c.chg);
   if (SampleLog* log = s.log.load(std::memory_order_acquire)) {
     LogRow row;
@@ -659,7 +854,7 @@ void Session::controlled_cycle(CommState& c) noexcept {
 void Session::apply(CommState& c, const Chg& chg) noexcept {
   How& h = c.how;
   const auto& joints = driver_.model().joints;
-  const double period_s = static_cast<double>(shared_->period_ns.load()) * 1e-9;
+  const double period_s = std::chrono::duration<double>(period()).count();
 
   if (chg.power == Request::on) {
     if (!driver_.set_power(true)) {
@@ -731,6 +926,7 @@ void Session::apply(CommState& c, const Chg& chg) noexcept {
 void Session::end_control(CommState& c, TerminateCode code, int joint,
                           std::string_view detail) noexcept {
   Shared& s = *shared_;
+  Clock& clk = *clock_;
   c.ended = true;
   std::uint32_t expected = kControlling;
   if (!s.phase.compare_exchange_strong(expected, kEnding, std::memory_order_seq_cst)) return;
@@ -748,47 +944,72 @@ void Session::end_control(CommState& c, TerminateCode code, int joint,
   }
   c.power_expected = false;
   s.phase.store(kEnded, std::memory_order_seq_cst);
-  ring(s.control_bell);
-  ring(s.planning_bell);
+  ring(clk.control_bell);
+  ring(clk.planning_bell);
 }
 
 // ---------------------------------------------------------------------------------------------
 // The control task
 
-void Session::control_task() noexcept {
-  Shared& s = *shared_;
+void Session::Clock::control_task() noexcept {
   std::uint32_t last = 0;
   for (;;) {
-    const std::uint32_t seen = s.control_bell.load();
-    if (s.stop.load(std::memory_order_acquire)) return;
-    // Busy before looking at the phase, so that release() waiting for !busy after changing the
-    // phase cannot miss a cycle that is about to start.
-    s.control_busy.store(true, std::memory_order_seq_cst);
-    if (s.phase.load(std::memory_order_seq_cst) == kControlling) {
-      const std::uint32_t k = s.how_ready.load(std::memory_order_acquire);
-      if (k != 0 && k != last) {
-        last = k;
-        control_cycle(k);
-        s.control_busy.store(false, std::memory_order_seq_cst);
-        ring(s.planning_bell);
-        continue;
-      }
+    const std::uint32_t seen = control_bell.load();
+    if (stop.load(std::memory_order_acquire)) return;
+    // Busy before looking at the robots' phases, so that release() waiting for !busy after
+    // changing a phase cannot miss a cycle that is about to start.
+    control_busy.store(true, std::memory_order_seq_cst);
+    const std::uint32_t k = how_ready.load(std::memory_order_acquire);
+    if (k != 0 && k != last) {
+      last = k;
+      control_cycle(k);
+      control_busy.store(false, std::memory_order_seq_cst);
+      ring(planning_bell);
+      continue;
     }
-    s.control_busy.store(false, std::memory_order_seq_cst);
-    wait_while(s.control_bell, seen);
+    control_busy.store(false, std::memory_order_seq_cst);
+    wait_while(control_bell, seen);
   }
 }
 
-void Session::control_cycle(std::uint32_t k) noexcept {
+void Session::Clock::control_cycle(std::uint32_t k) noexcept {
+  const auto in = [k](const Session* s) {
+    return s->shared_->in_cycle.load(std::memory_order_relaxed) == k &&
+           s->shared_->phase.load(std::memory_order_seq_cst) == kControlling;
+  };
+  for (Session* s : sessions) {
+    if (in(s)) s->run_f1(k);
+  }
+  chg_ready.store(k, std::memory_order_release);
+  ring(comm_bell);
+  for (;;) {
+    const std::uint32_t seen = control_bell.load();
+    if (reached(chg_taken.load(std::memory_order_acquire), k)) break;
+    if (stop.load(std::memory_order_acquire)) return;
+    wait_while(control_bell, seen);
+  }
+  std::int64_t spent_ns = 0;
+  for (Session* s : sessions) {
+    if (in(s)) spent_ns += s->run_f2();
+  }
+  const std::int64_t tick_ns = handed_tick_ns.load(std::memory_order_relaxed);
+  const std::int64_t end_ns =
+      simulated() ? tick_ns + spent_ns : std::max(monotonic_ns() - t0_ns, tick_ns);
+  control_end_ns.store(end_ns, std::memory_order_relaxed);
+  control_done.store(k, std::memory_order_release);  // the watchdog kick
+  ring(planning_bell);
+}
+
+void Session::run_f1(std::uint32_t k) noexcept {
+  (void)k;
   Shared& s = *shared_;
   Control& ctl = s.control;
   ctl.how_ = s.how;
-  ctl.period_s_ = static_cast<double>(s.period_ns.load(std::memory_order_relaxed)) * 1e-9;
+  ctl.period_s_ = std::chrono::duration<double>(period()).count();
   ctl.spent_ns_ = 0;
-  const auto run = [&](ControlFunction& f) {
-    if (!f) return;
+  if (f1_) {
     try {
-      f(ctl);
+      f1_(ctl);
     } catch (const std::exception& e) {
       ctl.message(e.what());
       request_termination(TerminateCode::control_exception, 0);
@@ -796,29 +1017,25 @@ void Session::control_cycle(std::uint32_t k) noexcept {
       ctl.message("unknown exception");
       request_termination(TerminateCode::control_exception, 0);
     }
-  };
-
-  run(f1_);
-  s.chg = ctl.chg_;
-  s.chg_ready.store(k, std::memory_order_release);
-  ring(s.comm_bell);
-  for (;;) {
-    const std::uint32_t seen = s.control_bell.load();
-    if (reached(s.chg_taken.load(std::memory_order_acquire), k)) break;
-    if (s.phase.load(std::memory_order_seq_cst) != kControlling) return;
-    if (s.stop.load(std::memory_order_acquire)) return;
-    wait_while(s.control_bell, seen);
   }
-  ctl.chg_.clear_commands();
-  run(f2_);
+  s.chg = ctl.chg_;
+}
 
-  const std::int64_t tick_ns = std::llround(ctl.how_.time_s * 1e9);
-  const std::int64_t end_ns = options_.clock == ClockKind::simulated
-                                  ? tick_ns + ctl.spent_ns_
-                                  : std::max(monotonic_ns() - s.t0_ns, tick_ns);
-  s.control_end_ns.store(end_ns, std::memory_order_relaxed);
-  s.control_done.store(k, std::memory_order_release);  // the watchdog kick
-  ring(s.planning_bell);
+std::int64_t Session::run_f2() noexcept {
+  Control& ctl = shared_->control;
+  ctl.chg_.clear_commands();
+  if (f2_) {
+    try {
+      f2_(ctl);
+    } catch (const std::exception& e) {
+      ctl.message(e.what());
+      request_termination(TerminateCode::control_exception, 0);
+    } catch (...) {
+      ctl.message("unknown exception");
+      request_termination(TerminateCode::control_exception, 0);
+    }
+  }
+  return ctl.spent_ns_;
 }
 
 }  // namespace rccx::rtc

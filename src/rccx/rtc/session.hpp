@@ -26,6 +26,7 @@
 #include <stdexcept>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "rccx/rtc/driver.hpp"
 #include "rccx/rtc/latency.hpp"
@@ -95,6 +96,8 @@ class Control {
 /// session ends with `control_exception`) but should not.
 using ControlFunction = std::function<void(Control&)>;
 
+class SessionGroup;
+
 class Session {
  public:
   /// rtc_open: starts the communication task (the arm is read every period from now on) and
@@ -111,8 +114,9 @@ class Session {
   /// rtc_release: stops control (the arm holds) and returns how it ended (`code` none if it
   /// was still running). Control may be started again after it.
   Termination release(bool power_off = false);
-  /// rtc_close: releases and stops both tasks, and puts RCCX_LOG's log in place. Called by
-  /// the destructor.
+  /// rtc_close: releases, stops both tasks (a session of a group: only this robot's control;
+  /// the group's tasks stop with the group), and puts RCCX_LOG's log in place. Called by the
+  /// destructor.
   void close(bool power_off = false);
   /// After close(): empty when RCCX_LOG's log (if any) is complete, else what went wrong (a
   /// write that failed, rows dropped), already said on stderr.
@@ -123,7 +127,8 @@ class Session {
 
   /// Lets `d` of time pass (in simulated time: runs those samples). Returns the termination
   /// if control ended meanwhile (or before), an empty one otherwise. Every wait function ends
-  /// within a period when SIGINT or SIGTERM arrives (rccx::io::stop_count() changes).
+  /// within a period when SIGINT or SIGTERM arrives (rccx::io::stop_count() changes). In a
+  /// group, simulated time is the group's: every robot of it moves on with the wait.
   Termination wait_for(std::chrono::nanoseconds d);
   /// Waits until control ends or `timeout` passes; returns the termination (code none on
   /// timeout).
@@ -137,10 +142,11 @@ class Session {
   [[nodiscard]] bool controlling() const noexcept;
   /// The termination of the present or last control session (code none while it runs).
   [[nodiscard]] Termination termination() const;
-  [[nodiscard]] std::chrono::nanoseconds period() const noexcept { return period_; }
-  /// Changes the sample period; only while control is not active.
+  /// This robot's sample period: the clock's period times its multiple (see SessionGroup).
+  [[nodiscard]] std::chrono::nanoseconds period() const noexcept;
+  /// Changes the sample period; only while control is not active, and not in a group.
   void set_period(std::chrono::nanoseconds period);
-  [[nodiscard]] ClockKind clock() const noexcept { return options_.clock; }
+  [[nodiscard]] ClockKind clock() const noexcept;
   [[nodiscard]] Driver& driver() noexcept { return driver_; }
   /// Records every controlled sample to `log` (commanded and measured joints, the commanded
   /// tool pose); nullptr stops. Only while not in control. Without a call, a session logs to
@@ -157,35 +163,81 @@ class Session {
 
  private:
   friend class Control;
+  friend class SessionGroup;
   struct Shared;
   struct CommState;
+  struct Clock;
 
-  void communication_task() noexcept;
-  bool wait_tick(CommState& c) noexcept;
-  void communication_cycle(CommState& c) noexcept;
-  void controlled_cycle(CommState& c) noexcept;
+  /// A robot of a group: sampled every `multiple`-th tick of `clock`.
+  Session(Driver& driver, std::shared_ptr<Clock> clock, int multiple, std::string log_suffix);
+  void open_channel(const std::string& log_suffix);
+
+  /// The communication task's work for this robot at tick k; true when it handed How to the
+  /// control task for this tick.
+  bool communication_cycle(CommState& c, std::uint32_t k, std::int64_t tick_ns) noexcept;
+  bool controlled_cycle(CommState& c, std::uint32_t k) noexcept;
+  void take_chg(CommState& c) noexcept;
   void apply(CommState& c, const Chg& chg) noexcept;
   void end_control(CommState& c, TerminateCode code, int joint, std::string_view detail) noexcept;
-  void control_task() noexcept;
-  void control_cycle(std::uint32_t k) noexcept;
+  void run_f1(std::uint32_t k) noexcept;
+  std::int64_t run_f2() noexcept;
   void request_termination(TerminateCode code, int joint) noexcept;
-  void step_simulated_sample();
   void wait_control_idle() const;
   [[nodiscard]] Termination ended_termination() const;
   void check_period(std::chrono::nanoseconds p) const;
+  [[nodiscard]] bool due(std::uint32_t k) const noexcept;
 
   Driver& driver_;
-  SessionOptions options_;
-  std::chrono::nanoseconds period_;
+  std::shared_ptr<Clock> clock_;
+  int multiple_ = 1;
+  bool owns_clock_ = false;
   std::unique_ptr<Shared> shared_;
+  std::unique_ptr<CommState> comm_;  ///< the communication task's own
   std::function<void(Session&)> hangup_handler_;
   std::unique_ptr<SampleLog> environment_log_;  ///< RCCX_LOG's, when set
   std::string log_problem_;
   ControlFunction f1_, f2_;
-  std::uint32_t simulated_ticks_ = 0;  ///< planning side: ticks granted in simulated time
-  std::thread communication_thread_;
-  std::thread control_thread_;
   bool closed_ = false;
+};
+
+/// Several robots on one clock (the workcell, thesis 5.2): one communication task and one
+/// control task sample every robot of the group at the same ticks, whatever their number. A
+/// robot may be sampled every k-th tick (the Microbo at 28 ms beside a PUMA at 7 ms: a 7 ms
+/// clock, multiples 4 and 1). Each robot has its own Session, with its own How / Chg, control
+/// functions, limits, faults and termination: one robot's fault ends that robot's control
+/// only. The control functions of all robots due at a tick run one after the other within
+/// that tick's period; the watchdog ends the control of every robot of a cycle that overruns.
+///
+///   rtc::SessionGroup group({.period = 7ms});
+///   rtc::Session& puma = group.add(puma_driver);
+///   rtc::Session& microbo = group.add(microbo_driver, 4);
+///   group.start();                 // the two tasks; then control() each as usual
+class SessionGroup {
+ public:
+  /// `options`: the clock (its period is the base period, simulated or real time).
+  explicit SessionGroup(SessionOptions options = {});
+  /// Stops the tasks (every robot's control released first).
+  ~SessionGroup();
+  SessionGroup(const SessionGroup&) = delete;
+  SessionGroup& operator=(const SessionGroup&) = delete;
+
+  /// Adds a robot sampled every `multiple`-th tick (1 .. 1000). Only before start(). Throws
+  /// SessionError for a period its driver cannot serve. With RCCX_LOG=FILE set, its log is
+  /// FILE with "-<robot name>" before the extension.
+  Session& add(Driver& driver, int multiple = 1);
+  /// Starts the communication and control tasks; robots are read every tick from now on.
+  void start();
+  [[nodiscard]] std::size_t size() const noexcept { return sessions_.size(); }
+  [[nodiscard]] Session& operator[](std::size_t i) { return *sessions_.at(i); }
+  /// The base period of the clock.
+  [[nodiscard]] std::chrono::nanoseconds period() const noexcept;
+  [[nodiscard]] LatencyStats latency() const;
+  /// Simulated time: lets `d` pass for every robot (control of each goes on as it is).
+  void wait_for(std::chrono::nanoseconds d);
+
+ private:
+  std::shared_ptr<Session::Clock> clock_;
+  std::vector<std::unique_ptr<Session>> sessions_;
 };
 
 }  // namespace rccx::rtc

@@ -1,0 +1,229 @@
+// Several robots on one clock (rtc::SessionGroup): each sampled at the ticks of its multiple,
+// its own control and termination, a fixed number of threads whatever their number.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <cstdlib>
+#include <dirent.h>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "rccx/hw/ideal_arm.hpp"
+#include "rccx/kinematics/kinematics.hpp"
+#include "rccx/rtc/servo_driver.hpp"
+#include "rccx/rtc/session.hpp"
+
+using namespace rccx;
+using namespace std::chrono_literals;
+using rtc::TerminateCode;
+
+namespace {
+
+/// N ideal arms and their drivers, for a group.
+struct Arms {
+  std::vector<std::unique_ptr<hw::IdealArm>> arms;
+  std::vector<std::unique_ptr<rtc::ServoDriver>> drivers;
+  explicit Arms(std::size_t n, const std::string& robot = "puma560") {
+    const kin::RobotModel model = kin::builtin_robot(robot);
+    for (std::size_t i = 0; i < n; ++i) {
+      arms.push_back(std::make_unique<hw::IdealArm>(model));
+      drivers.push_back(std::make_unique<rtc::ServoDriver>(*arms.back()));
+    }
+  }
+};
+
+rtc::SessionOptions clock_of(std::chrono::nanoseconds period) {
+  rtc::SessionOptions o;
+  o.period = period;
+  o.clock = rtc::ClockKind::simulated;
+  return o;
+}
+
+std::size_t threads_of_this_process() {
+  std::size_t n = 0;
+  for (const auto& e : std::filesystem::directory_iterator("/proc/self/task")) {
+    (void)e;
+    ++n;
+  }
+  return n;
+}
+
+}  // namespace
+
+TEST(SessionGroup, EachRobotIsSampledAtTheTicksOfItsMultiple) {
+  Arms a(2);
+  rtc::SessionGroup group(clock_of(7ms));
+  rtc::Session& fast = group.add(*a.drivers[0]);
+  rtc::Session& slow = group.add(*a.drivers[1], 4);
+  group.start();
+  EXPECT_EQ(fast.period(), 7ms);
+  EXPECT_EQ(slow.period(), 28ms);
+  // Written only by the control task, read after the waits.
+  auto fast_samples = std::make_shared<std::vector<std::uint64_t>>();
+  auto slow_samples = std::make_shared<std::vector<std::uint64_t>>();
+  auto slow_times = std::make_shared<std::vector<double>>();
+  auto slow_period = std::make_shared<double>(0.0);
+  fast.control([=](rtc::Control& c) { fast_samples->push_back(c.how().sample); }, {});
+  slow.control(
+      [=](rtc::Control& c) {
+        slow_samples->push_back(c.how().sample);
+        slow_times->push_back(c.how().time_s);
+        *slow_period = c.period_s();
+      },
+      {});
+  group.wait_for(280ms);  // 40 ticks
+  fast.release();
+  slow.release();
+  ASSERT_GE(fast_samples->size(), 38U);
+  for (std::size_t i = 1; i < fast_samples->size(); ++i) {
+    EXPECT_EQ((*fast_samples)[i], (*fast_samples)[i - 1] + 1) << "the fast robot skipped a tick";
+  }
+  ASSERT_GE(slow_samples->size(), 9U);
+  for (std::size_t i = 0; i < slow_samples->size(); ++i) {
+    EXPECT_EQ(((*slow_samples)[i] - 1) % 4, 0U) << "sampled at tick " << (*slow_samples)[i];
+    if (i > 0) {
+      EXPECT_EQ((*slow_samples)[i], (*slow_samples)[i - 1] + 4);
+      EXPECT_NEAR((*slow_times)[i] - (*slow_times)[i - 1], 0.028, 1e-9);
+    }
+  }
+  EXPECT_DOUBLE_EQ(*slow_period, 0.028);
+  // The same clock: ticks the two share carry the same time.
+  EXPECT_EQ(fast.how().time_s, fast.how().time_s);
+}
+
+TEST(SessionGroup, OneRobotsFaultEndsItsControlOnlyAndTheOthersGoOn) {
+  Arms a(3);
+  rtc::SessionGroup group(clock_of(10ms));
+  std::vector<rtc::Session*> s;
+  for (auto& d : a.drivers) s.push_back(&group.add(*d));
+  group.start();
+  for (rtc::Session* x : s) x->control({}, {});
+  group.wait_for(50ms);
+  a.arms[1]->inject(hw::Fault::joint_not_answering, 2);
+  group.wait_for(50ms);
+  const rtc::Termination t = s[1]->termination();
+  EXPECT_EQ(t.code, TerminateCode::joint_not_answering);
+  EXPECT_EQ(t.joint, 3);
+  EXPECT_TRUE(s[0]->controlling());
+  EXPECT_TRUE(s[2]->controlling());
+  const std::uint64_t before = s[0]->how().sample;
+  group.wait_for(100ms);
+  EXPECT_EQ(s[0]->how().sample, before + 10) << "the others' samples go on";
+  for (rtc::Session* x : s) x->release();
+}
+
+TEST(SessionGroup, ReleaseAndControlOneRobotWhileTheOthersRun) {
+  Arms a(2);
+  rtc::SessionGroup group(clock_of(10ms));
+  rtc::Session& r0 = group.add(*a.drivers[0]);
+  rtc::Session& r1 = group.add(*a.drivers[1]);
+  group.start();
+  auto n0 = std::make_shared<std::atomic<int>>(0);
+  auto n1 = std::make_shared<std::atomic<int>>(0);
+  r0.control([n0](rtc::Control&) { ++*n0; }, {});
+  r1.control([n1](rtc::Control&) { ++*n1; }, {});
+  group.wait_for(100ms);
+  EXPECT_FALSE(r0.release().ended());
+  const int at_release = *n0;
+  group.wait_for(100ms);
+  EXPECT_EQ(*n0, at_release) << "a released robot's functions ran";
+  EXPECT_GE(*n1, 19);
+  r0.control([n0](rtc::Control&) { ++*n0; }, {});
+  group.wait_for(100ms);
+  EXPECT_GE(*n0, at_release + 9);
+  r0.release();
+  r1.release();
+}
+
+TEST(SessionGroup, ACycleThatOverrunsEndsEveryRobotInIt) {
+  Arms a(2);
+  rtc::SessionGroup group(clock_of(10ms));
+  rtc::Session& r0 = group.add(*a.drivers[0]);
+  rtc::Session& r1 = group.add(*a.drivers[1]);
+  group.start();
+  // 6 ms each: alone each fits its 10 ms, together the cycle takes 12 ms.
+  r0.control({}, [](rtc::Control& c) { c.spend(6ms); });
+  group.wait_for(50ms);
+  EXPECT_TRUE(r0.controlling());
+  r1.control({}, [](rtc::Control& c) { c.spend(6ms); });
+  group.wait_for(50ms);
+  EXPECT_EQ(r0.termination().code, TerminateCode::overrun);
+  EXPECT_EQ(r1.termination().code, TerminateCode::overrun);
+  r0.release();
+  r1.release();
+}
+
+TEST(SessionGroup, ThreadsDoNotGrowWithTheNumberOfRobots) {
+  Arms small(2), large(64);
+  const std::size_t before = threads_of_this_process();
+  std::size_t with_two = 0, with_many = 0;
+  {
+    rtc::SessionGroup g(clock_of(1ms));
+    for (auto& d : small.drivers) g.add(*d);
+    g.start();
+    for (std::size_t i = 0; i < g.size(); ++i) g[i].control({}, {});
+    g.wait_for(20ms);
+    with_two = threads_of_this_process() - before;
+    for (std::size_t i = 0; i < g.size(); ++i) g[i].release();
+  }
+  {
+    rtc::SessionGroup g(clock_of(1ms));
+    for (auto& d : large.drivers) g.add(*d);
+    g.start();
+    for (std::size_t i = 0; i < g.size(); ++i) g[i].control({}, {});
+    g.wait_for(20ms);
+    with_many = threads_of_this_process() - before;
+    for (std::size_t i = 0; i < g.size(); ++i) EXPECT_TRUE(g[i].controlling());
+    for (std::size_t i = 0; i < g.size(); ++i) g[i].release();
+  }
+  EXPECT_EQ(with_many, with_two);
+  EXPECT_LE(with_many, 3U) << "the two tasks, and the Ctrl-C watcher";
+}
+
+TEST(SessionGroup, EachRobotHasItsOwnEnvironmentLog) {
+  const std::filesystem::path dir = ::testing::TempDir();
+  const std::string base = (dir / "group_env_log.csv").string();
+  Arms a(1, "puma560");
+  Arms b(1, "stanford");
+  ::setenv("RCCX_LOG", base.c_str(), 1);
+  {
+    rtc::SessionGroup group(clock_of(10ms));
+    rtc::Session& p = group.add(*a.drivers[0]);
+    rtc::Session& q = group.add(*b.drivers[0], 2);
+    ::unsetenv("RCCX_LOG");
+    group.start();
+    p.control({}, {});
+    q.control({}, {});
+    group.wait_for(100ms);
+    p.release();
+    q.release();
+  }
+  for (const auto& [name, rows] : {std::pair{"puma560", 10}, std::pair{"stanford", 5}}) {
+    const auto file = dir / ("group_env_log-" + std::string(name) + ".csv");
+    std::ifstream in(file);
+    ASSERT_TRUE(in.good()) << file;
+    std::string line;
+    int n = -1;  // the header
+    while (std::getline(in, line)) ++n;
+    EXPECT_NEAR(n, rows, 1) << file;
+    std::filesystem::remove(file);
+  }
+}
+
+TEST(SessionGroup, MisuseIsRefusedWithAReason) {
+  Arms a(1);
+  rtc::SessionGroup group(clock_of(10ms));
+  EXPECT_THROW(group.start(), rtc::SessionError);  // no robot
+  rtc::Session& s = group.add(*a.drivers[0]);
+  EXPECT_THROW(s.control({}, {}), rtc::SessionError);  // not started
+  EXPECT_THROW(group.add(*a.drivers[0], 0), rtc::SessionError);
+  EXPECT_THROW(group.add(*a.drivers[0], 9), rtc::SessionError);  // 90 ms: beyond 56 ms
+  group.start();
+  EXPECT_THROW(group.add(*a.drivers[0]), rtc::SessionError);  // after start
+  EXPECT_THROW(s.set_period(20ms), rtc::SessionError);
+  EXPECT_THROW(rtc::SessionGroup(clock_of(100ms)), rtc::SessionError);
+}
