@@ -41,9 +41,11 @@ std::string pose_text(const math::Transform& T) {
 
 json pose_json(const math::Transform& T) {
   const auto rpy = T.R.to_rpy();
-  return {
-      {"xyz_m", {T.p.x, T.p.y, T.p.z}},
-      {"rpy_deg", {math::rad_to_deg(rpy[0]), math::rad_to_deg(rpy[1]), math::rad_to_deg(rpy[2])}}};
+  // + 0.0 turns the -0.0 of round-off into 0.
+  return {{"xyz_m", {T.p.x + 0.0, T.p.y + 0.0, T.p.z + 0.0}},
+          {"rpy_deg",
+           {math::rad_to_deg(rpy[0]) + 0.0, math::rad_to_deg(rpy[1]) + 0.0,
+            math::rad_to_deg(rpy[2]) + 0.0}}};
 }
 
 std::string shape_text(const cell::Shape& s) {
@@ -77,7 +79,7 @@ int run_show(const ShowArgs& args) {
       const cell::CellRobot& r = c.robots[i];
       json item{{"name", r.name},
                 {"robot", r.model.name},
-                {"robot_file", r.model_file},
+                {"robot_file", r.model_file.empty() ? json(nullptr) : json(r.model_file)},
                 {"period_multiple", r.period_multiple},
                 {"period_ms", ms(c.period(i))},
                 {"base", pose_json(r.base)},
