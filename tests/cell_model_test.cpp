@@ -148,6 +148,11 @@ TEST(CellFile, BadFilesNameTheKey) {
       {[](json& j) { j["collision_margin_m"] = 2; }, "\"collision_margin_m\""},
       {[](json& j) { j["name"] = "my cell"; }, "\"name\""},
       {[](json& j) { j["title"] = "tab\x01"; }, "\"title\""},
+      {[](json& j) {
+         j["notes"] = json::array({"fine", 3});
+       },
+       "\"notes\" must be text"},
+      {[](json& j) { j["notes"] = "bell\x07"; }, "\"notes\""},
       {[&](json& j) { robot(j, 1)["period_multiple"] = 0; }, "\"period_multiple\" is 0"},
       {[&](json& j) { robot(j, 1)["period_multiple"] = 1001; }, "\"period_multiple\" is 1001"},
       {[&](json& j) { robot(j, 1)["period_multiple"] = 2.5; },

@@ -447,6 +447,11 @@ CellModel parse_cell_json(std::string_view text, std::string_view origin,
   if (r.has("notes")) {
     const json& notes = r.get("notes");
     if (!notes.is_string() && !notes.is_array()) r.fail("\"notes\" must be text or a list of it");
+    const Checker c{r.where()};
+    for (const json& note : notes.is_array() ? notes : json::array({notes})) {
+      if (!note.is_string()) r.fail("\"notes\" must be text or a list of it");
+      c.text(note.get<std::string>(), "notes");
+    }
   }
   // Milliseconds as people think of sample periods; kept whole in ns from here on.
   const double period_ms = r.number("base_period_ms", 1e6);
