@@ -5,6 +5,7 @@
 #include <exception>
 #include <system_error>
 
+#include "cell_command.hpp"
 #include "cli_common.hpp"
 #include "db_command.hpp"
 #include "kin_command.hpp"
@@ -38,6 +39,7 @@ int run(int argc, char** argv) {
   rccx::tools::add_rcu_command(app, exit_code);
   rccx::tools::add_db_command(app, exit_code);
   rccx::tools::add_teach_command(app, exit_code);
+  rccx::tools::add_cell_command(app, exit_code);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -1,0 +1,574 @@
+#include "rccx/cell/cell_model.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <random>
+#include <set>
+
+#include "rccx/io/file.hpp"
+#include "rccx/io/parse.hpp"
+#include "rccx/kinematics/kinematics.hpp"
+#include "rccx/math/units.hpp"
+
+namespace rccx::cell {
+
+using nlohmann::json;
+
+std::string_view to_string(ShapeKind kind) noexcept {
+  return kind == ShapeKind::box ? "box" : "cylinder";
+}
+
+const CellRobot* CellModel::find_robot(std::string_view robot_name) const noexcept {
+  for (const CellRobot& r : robots) {
+    if (r.name == robot_name) return &r;
+  }
+  return nullptr;
+}
+
+const CellObject* CellModel::find_object(std::string_view object_name) const noexcept {
+  for (const CellObject& o : objects) {
+    if (o.name == object_name) return &o;
+  }
+  return nullptr;
+}
+
+const CellFrame* CellModel::find_frame(std::string_view frame_name) const noexcept {
+  for (const CellFrame& f : frames) {
+    if (f.name == frame_name) return &f;
+  }
+  return nullptr;
+}
+
+namespace {
+
+double ms_of(std::chrono::nanoseconds t) {
+  return static_cast<double>(t.count()) * 1e-6;
+}
+
+// ---- Rules on the data, whether it came from a file or from code ----
+
+class Checker {
+ public:
+  explicit Checker(std::string where) : where_(std::move(where)) {}
+
+  [[noreturn]] void fail(const std::string& what) const {
+    throw CellFileError(fmt::format("{}: {}", where_, what));
+  }
+
+  void name(const std::string& n, const char* key = "name") const {
+    try {
+      io::check_name(n, fmt::format("\"{}\"", key), kMaxName);
+    } catch (const io::ParseError& e) {
+      fail(e.what());
+    }
+  }
+
+  void text(const std::string& t, const char* key) const {
+    try {
+      io::check_text(t, fmt::format("\"{}\"", key), kMaxText);
+    } catch (const io::ParseError& e) {
+      fail(e.what());
+    }
+  }
+
+  /// A pose: finite, within kMaxLength_m on each axis, and a proper rotation (orthonormal,
+  /// right-handed), which every product of poses downstream takes for granted.
+  void pose(const math::Transform& T, const char* key) const {
+    for (int i = 0; i < 3; ++i) {
+      if (!std::isfinite(T.p[i]) || std::abs(T.p[i]) > kMaxLength_m) {
+        fail(fmt::format("\"{}\": the position must be finite and within {:g} m of the origin", key,
+                         kMaxLength_m));
+      }
+    }
+    const math::Rot3 RtR = T.R.transposed() * T.R;
+    double error = 0.0;
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) {
+        const double e = std::abs(RtR(r, c) - (r == c ? 1.0 : 0.0));
+        error = std::isfinite(e) ? std::max(error, e) : INFINITY;
+      }
+    }
+    const double det = math::dot(math::cross(T.R.n, T.R.o), T.R.a);
+    if (!(error <= 1e-6) || !(det > 0)) {
+      fail(fmt::format("\"{}\": the rotation is not orthonormal and right-handed", key));
+    }
+  }
+
+  /// A length in (0, limit] m.
+  void positive_length(double v, const char* key, double limit = kMaxLength_m) const {
+    if (!std::isfinite(v) || v <= 0.0 || v > limit) {
+      fail(fmt::format("\"{}\" is {:g}; more than 0 and at most {:g} m", key, v, limit));
+    }
+  }
+
+  const std::string& where() const { return where_; }
+
+ private:
+  std::string where_;
+};
+
+std::string robot_where(std::string_view origin, std::size_t i, const std::string& name) {
+  return fmt::format("{}: robot {} \"{}\"", origin, i + 1, name);  // a checked name
+}
+
+}  // namespace
+
+void validate(const CellModel& cell, std::string_view origin) {
+  const Checker top{std::string(origin)};
+  top.name(cell.name);
+  top.text(cell.title, "title");
+  top.text(cell.source, "source");
+  if (cell.base_period < kMinPeriod || cell.base_period > kMaxPeriod) {
+    top.fail(fmt::format("\"base_period_ms\" is {:g}; {:g} to {:g} ms", ms_of(cell.base_period),
+                         ms_of(kMinPeriod), ms_of(kMaxPeriod)));
+  }
+  if (cell.robots.empty() || cell.robots.size() > kMaxRobots) {
+    top.fail(fmt::format("\"robots\" has {}; a cell has 1 to {} robots", cell.robots.size(),
+                         kMaxRobots));
+  }
+  if (!std::isfinite(cell.collision_margin_m) || cell.collision_margin_m < 0.0 ||
+      cell.collision_margin_m > kMaxRadius_m) {
+    top.fail(fmt::format("\"collision_margin_m\" is {:g}; 0 to {:g} m", cell.collision_margin_m,
+                         kMaxRadius_m));
+  }
+
+  std::map<std::string, std::size_t, std::less<>> robot_names;
+  for (std::size_t i = 0; i < cell.robots.size(); ++i) {
+    const CellRobot& r = cell.robots[i];
+    const Checker at{fmt::format("{}: robot {}", origin, i + 1)};
+    at.name(r.name);
+    const Checker c{robot_where(origin, i, r.name)};
+    if (const auto [it, fresh] = robot_names.emplace(r.name, i); !fresh) {
+      c.fail(fmt::format("\"name\" \"{}\" is robot {}'s already; robot names must be unique",
+                         r.name, it->second + 1));
+    }
+    if (r.model.dof() == 0 || r.model.dof() > kin::kMaxJoints) {
+      c.fail(fmt::format("its robot model has {} joints; 1 to {}", r.model.dof(), kin::kMaxJoints));
+    }
+    c.pose(r.base, "base");
+    if (r.tool) c.pose(*r.tool, "tool");
+    if (r.period_multiple < 1 || r.period_multiple > kMaxPeriodMultiple) {
+      c.fail(
+          fmt::format("\"period_multiple\" is {}; 1 to {}", r.period_multiple, kMaxPeriodMultiple));
+    }
+    const std::chrono::nanoseconds period = cell.period(i);
+    if (period < kMinPeriod || period > kMaxPeriod) {
+      c.fail(fmt::format(
+          "\"period_multiple\" {} makes its period {:g} ms ({:g} ms x {}); RTC serves {:g} to "
+          "{:g} ms",
+          r.period_multiple, ms_of(period), ms_of(cell.base_period), r.period_multiple,
+          ms_of(kMinPeriod), ms_of(kMaxPeriod)));
+    }
+    if (r.link_radius_m.size() != r.model.dof()) {
+      c.fail(fmt::format(
+          "\"link_radius_m\" has {} values; robot {} has {} joints (give one number for all, "
+          "or one per joint)",
+          r.link_radius_m.size(), r.model.name, r.model.dof()));
+    }
+    for (const double radius : r.link_radius_m)
+      c.positive_length(radius, "link_radius_m", kMaxRadius_m);
+    c.text(r.note, "note");
+  }
+
+  if (cell.objects.size() > kMaxObjects) {
+    top.fail(fmt::format("\"objects\" has {}; at most {}", cell.objects.size(), kMaxObjects));
+  }
+  if (cell.frames.size() > kMaxFrames) {
+    top.fail(fmt::format("\"frames\" has {}; at most {}", cell.frames.size(), kMaxFrames));
+  }
+  // Objects and frames share one namespace: a program names a place without saying which.
+  std::map<std::string, std::string, std::less<>> place_names;
+  for (std::size_t i = 0; i < cell.objects.size(); ++i) {
+    const CellObject& o = cell.objects[i];
+    const Checker at{fmt::format("{}: object {}", origin, i + 1)};
+    at.name(o.name);
+    const Checker c{fmt::format("{}: object {} \"{}\"", origin, i + 1, o.name)};
+    const std::string self = fmt::format("object {}", i + 1);
+    if (const auto [it, fresh] = place_names.emplace(o.name, self); !fresh) {
+      c.fail(fmt::format("\"name\" \"{}\" is {}'s already; object and frame names must be unique",
+                         o.name, it->second));
+    }
+    if (o.shape.kind == ShapeKind::box) {
+      for (int k = 0; k < 3; ++k) c.positive_length(o.shape.size_m[k], "size_m");
+    } else {
+      c.positive_length(o.shape.radius_m, "radius_m");
+      c.positive_length(o.shape.height_m, "height_m");
+    }
+    c.pose(o.pose, "pose");
+    c.text(o.note, "note");
+  }
+  for (std::size_t i = 0; i < cell.frames.size(); ++i) {
+    const CellFrame& f = cell.frames[i];
+    const Checker at{fmt::format("{}: frame {}", origin, i + 1)};
+    at.name(f.name);
+    const Checker c{fmt::format("{}: frame {} \"{}\"", origin, i + 1, f.name)};
+    const std::string self = fmt::format("frame {}", i + 1);
+    if (const auto [it, fresh] = place_names.emplace(f.name, self); !fresh) {
+      c.fail(fmt::format("\"name\" \"{}\" is {}'s already; object and frame names must be unique",
+                         f.name, it->second));
+    }
+    c.pose(f.pose, "pose");
+    c.text(f.note, "note");
+  }
+}
+
+namespace {
+
+// ---- The file ----
+
+// Reads a JSON object key by key so that every error names where it is, and so that an unknown
+// key (a typo such as "base_period_s") is refused instead of silently ignored (the robot
+// files' reader, robot_model.cpp, with this layer's error type).
+class Reader {
+ public:
+  Reader(const json& object, std::string where) : object_(object), where_(std::move(where)) {
+    if (!object_.is_object()) fail("expected an object");
+  }
+
+  [[noreturn]] void fail(const std::string& what) const {
+    throw CellFileError(fmt::format("{}: {}", where_, what));
+  }
+
+  bool has(const char* key) {
+    used_.insert(key);
+    return object_.contains(key);
+  }
+
+  const json& get(const char* key) {
+    if (!has(key)) fail(fmt::format("missing \"{}\"", key));
+    return object_.at(key);
+  }
+
+  std::string string(const char* key) {
+    const json& v = get(key);
+    if (!v.is_string()) fail(fmt::format("\"{}\" must be a string", key));
+    return v.get<std::string>();
+  }
+
+  std::string string_or(const char* key) { return has(key) ? string(key) : std::string(); }
+
+  /// A finite number no larger than `limit` in magnitude.
+  double number(const json& v, const std::string& what, double limit) const {
+    if (!v.is_number()) fail(fmt::format("{} must be a number", what));
+    const double d = v.get<double>();
+    if (!std::isfinite(d)) fail(fmt::format("{} must be finite", what));
+    if (std::abs(d) > limit) {
+      fail(fmt::format("{} is {:g}; at most {:g} in magnitude", what, d, limit));
+    }
+    return d;
+  }
+
+  double number(const char* key, double limit) {
+    return number(get(key), fmt::format("\"{}\"", key), limit);
+  }
+
+  /// `count` numbers, each as number().
+  template <std::size_t N>
+  std::array<double, N> numbers(const char* key, double limit) {
+    const json& v = get(key);
+    if (!v.is_array() || v.size() != N) fail(fmt::format("\"{}\" must be {} numbers", key, N));
+    std::array<double, N> out{};
+    for (std::size_t i = 0; i < N; ++i) {
+      out[i] = number(v[i], fmt::format("\"{}\" [{}]", key, i + 1), limit);
+    }
+    return out;
+  }
+
+  /// A whole number in [lo, hi].
+  std::int64_t integer(const char* key, std::int64_t lo, std::int64_t hi) {
+    const json& v = get(key);
+    if (!v.is_number_integer()) fail(fmt::format("\"{}\" must be a whole number", key));
+    const bool fits = v.is_number_unsigned()
+                          ? v.get<std::uint64_t>() <= static_cast<std::uint64_t>(hi) &&
+                                static_cast<std::int64_t>(v.get<std::uint64_t>()) >= lo
+                          : v.get<std::int64_t>() >= lo && v.get<std::int64_t>() <= hi;
+    if (!fits) fail(fmt::format("\"{}\" is {}; {} to {}", key, v.dump(), lo, hi));
+    return v.is_number_unsigned() ? static_cast<std::int64_t>(v.get<std::uint64_t>())
+                                  : v.get<std::int64_t>();
+  }
+
+  void no_unknown_keys() const {
+    for (const auto& item : object_.items()) {
+      if (!used_.contains(item.key())) fail(fmt::format("unknown key \"{}\"", item.key()));
+    }
+  }
+
+  const std::string& where() const { return where_; }
+
+ private:
+  const json& object_;
+  std::string where_;
+  std::set<std::string> used_;
+};
+
+/// {"xyz_m": [x, y, z], "rpy_deg": [roll, pitch, yaw]} (Paul's RPY: Rot(z, roll) Rot(y, pitch)
+/// Rot(x, yaw); rpy_deg may be left out) or {"rows_m": [12 numbers, row by row]}.
+math::Transform parse_pose(const json& j, const std::string& where) {
+  Reader r(j, where);
+  const bool rows = j.is_object() && j.contains("rows_m");
+  if (rows && (j.contains("xyz_m") || j.contains("rpy_deg"))) {
+    r.fail("give \"xyz_m\" and \"rpy_deg\", or \"rows_m\", not both");
+  }
+  math::Transform T;
+  if (rows) {
+    const auto m = r.numbers<12>("rows_m", kMaxLength_m);
+    T = math::Transform::from_rows(m);
+    // The rotation is checked by validate(); round-off in a typed matrix is not an error, so it
+    // is made exactly orthonormal once it has passed.
+    const Checker c{where};
+    c.pose(T, "rows_m");
+    T.R = T.R.orthonormalized();
+  } else {
+    const auto p = r.numbers<3>("xyz_m", kMaxLength_m);
+    T.p = {p[0], p[1], p[2]};
+    if (r.has("rpy_deg")) {
+      const auto rpy = r.numbers<3>("rpy_deg", 360.0);
+      T.R = math::Rot3::from_rpy(math::deg_to_rad(rpy[0]), math::deg_to_rad(rpy[1]),
+                                 math::deg_to_rad(rpy[2]));
+    }
+  }
+  r.no_unknown_keys();
+  return T;
+}
+
+CellRobot parse_robot(const json& j, const std::string& where,
+                      const std::filesystem::path& base_dir) {
+  Reader r(j, where);
+  CellRobot robot;
+  robot.name = r.string("name");
+  const bool shipped = r.has("robot");
+  const bool file = r.has("robot_file");
+  if (shipped == file) r.fail("give \"robot\" (a shipped robot) or \"robot_file\" (a path), one");
+  try {
+    if (shipped) {
+      robot.model = kin::builtin_robot(r.string("robot"));
+    } else {
+      robot.model_file = r.string("robot_file");
+      if (robot.model_file.empty()) r.fail("\"robot_file\" is empty; name a robot file");
+      if (base_dir.empty()) {
+        r.fail("\"robot_file\" needs the cell to be read from a file; use \"robot\"");
+      }
+      robot.model = kin::load_robot_file(base_dir / robot.model_file);
+    }
+    // The solver the model asks for must accept its DH table (a closed form checks at build).
+    (void)kin::make_kinematics(robot.model);
+  } catch (const kin::RobotFileError& e) {
+    r.fail(fmt::format("\"{}\": {}", shipped ? "robot" : "robot_file", e.what()));
+  }
+  robot.base = parse_pose(r.get("base"), where + ": \"base\"");
+  robot.period_multiple =
+      static_cast<std::uint32_t>(r.integer("period_multiple", 1, kMaxPeriodMultiple));
+  const json& radius = r.get("link_radius_m");
+  if (radius.is_number()) {
+    robot.link_radius_m.assign(robot.model.dof(), r.number("link_radius_m", kMaxRadius_m));
+  } else if (radius.is_array() && radius.size() <= kin::kMaxJoints) {
+    for (std::size_t i = 0; i < radius.size(); ++i) {
+      robot.link_radius_m.push_back(
+          r.number(radius[i], fmt::format("\"link_radius_m\" [{}]", i + 1), kMaxRadius_m));
+    }
+  } else {
+    r.fail("\"link_radius_m\" must be a number, or one number per joint");
+  }
+  if (r.has("tool")) robot.tool = parse_pose(r.get("tool"), where + ": \"tool\"");
+  robot.note = r.string_or("note");
+  r.no_unknown_keys();
+  return robot;
+}
+
+CellObject parse_object(const json& j, const std::string& where) {
+  Reader r(j, where);
+  CellObject o;
+  o.name = r.string("name");
+  const std::string shape = r.string("shape");
+  if (shape == "box") {
+    o.shape.kind = ShapeKind::box;
+    const auto s = r.numbers<3>("size_m", kMaxLength_m);
+    o.shape.size_m = {s[0], s[1], s[2]};
+  } else if (shape == "cylinder") {
+    o.shape.kind = ShapeKind::cylinder;
+    o.shape.radius_m = r.number("radius_m", kMaxLength_m);
+    o.shape.height_m = r.number("height_m", kMaxLength_m);
+  } else {
+    r.fail(
+        fmt::format("\"shape\" is {}; use \"box\" (with \"size_m\") or \"cylinder\" (with "
+                    "\"radius_m\" and \"height_m\")",
+                    io::quoted(shape)));
+  }
+  o.pose = parse_pose(r.get("pose"), where + ": \"pose\"");
+  if (r.has("movable")) {
+    const json& m = r.get("movable");
+    if (!m.is_boolean()) r.fail("\"movable\" must be true or false");
+    o.movable = m.get<bool>();
+  }
+  o.note = r.string_or("note");
+  r.no_unknown_keys();
+  return o;
+}
+
+CellFrame parse_frame(const json& j, const std::string& where) {
+  Reader r(j, where);
+  CellFrame f;
+  f.name = r.string("name");
+  f.pose = parse_pose(r.get("pose"), where + ": \"pose\"");
+  f.note = r.string_or("note");
+  r.no_unknown_keys();
+  return f;
+}
+
+/// An array member of the top object, at most `max` long (checked before anything is built
+/// from it, so that a huge list costs nothing).
+const json& list(Reader& r, const char* key, std::size_t max, bool required) {
+  static const json kEmpty = json::array();
+  if (!required && !r.has(key)) return kEmpty;
+  const json& v = r.get(key);
+  if (!v.is_array()) r.fail(fmt::format("\"{}\" must be a list", key));
+  if (v.size() > max) r.fail(fmt::format("\"{}\" has {}; at most {}", key, v.size(), max));
+  return v;
+}
+
+CellModel parse_cell_json(std::string_view text, std::string_view origin,
+                          const std::filesystem::path& base_dir) {
+  json doc;
+  try {
+    doc = json::parse(text, nullptr, /*allow_exceptions=*/true, /*ignore_comments=*/true);
+  } catch (const json::exception& e) {  // syntax, or a number that overflows a double
+    throw CellFileError(fmt::format("{}: not valid JSON: {}", origin, e.what()));
+  }
+  Reader r(doc, std::string(origin));
+  CellModel cell;
+  cell.name = r.string("name");
+  cell.title = r.string("title");
+  cell.source = r.string("source");
+  if (r.has("notes")) {
+    const json& notes = r.get("notes");
+    if (!notes.is_string() && !notes.is_array()) r.fail("\"notes\" must be text or a list of it");
+    const Checker c{r.where()};
+    for (const json& note : notes.is_array() ? notes : json::array({notes})) {
+      if (!note.is_string()) r.fail("\"notes\" must be text or a list of it");
+      c.text(note.get<std::string>(), "notes");
+    }
+  }
+  // Milliseconds as people think of sample periods; kept whole in ns from here on.
+  const double period_ms = r.number("base_period_ms", 1e6);
+  cell.base_period = std::chrono::nanoseconds{std::llround(period_ms * 1e6)};
+  cell.collision_margin_m = r.number("collision_margin_m", kMaxLength_m);
+  const json& robots = list(r, "robots", kMaxRobots, true);
+  for (std::size_t i = 0; i < robots.size(); ++i) {
+    cell.robots.push_back(
+        parse_robot(robots[i], fmt::format("{}: robot {}", origin, i + 1), base_dir));
+  }
+  const json& objects = list(r, "objects", kMaxObjects, false);
+  for (std::size_t i = 0; i < objects.size(); ++i) {
+    cell.objects.push_back(parse_object(objects[i], fmt::format("{}: object {}", origin, i + 1)));
+  }
+  const json& frames = list(r, "frames", kMaxFrames, false);
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    cell.frames.push_back(parse_frame(frames[i], fmt::format("{}: frame {}", origin, i + 1)));
+  }
+  r.no_unknown_keys();
+  validate(cell, origin);
+  return cell;
+}
+
+}  // namespace
+
+CellModel parse_cell(std::string_view text, std::string_view origin,
+                     const std::filesystem::path& base_dir) {
+  try {
+    return parse_cell_json(text, origin, base_dir);
+  } catch (const json::exception& e) {  // e.g. a key that is not UTF-8 met by a message
+    throw CellFileError(fmt::format("{}: {}", origin, e.what()));
+  }
+}
+
+CellModel load_cell_file(const std::filesystem::path& path) {
+  std::string text;
+  try {
+    text = io::read_file(path, 16U << 20);  // 1024 robots with notes stay far below
+  } catch (const io::FileError& e) {
+    throw CellFileError(fmt::format("{} (the cell file)", e.what()));
+  }
+  std::filesystem::path dir = path.parent_path();
+  if (dir.empty()) dir = ".";
+  return parse_cell(text, path.string(), dir);
+}
+
+// ---- Geometry ----
+
+double reach_m(const kin::RobotModel& model, const std::optional<math::Transform>& tool) {
+  double sum = 0.0;
+  for (const kin::Joint& j : model.joints) {
+    sum += std::abs(j.dh.a_m);
+    if (j.type == kin::JointType::prismatic) {
+      sum += std::max(std::abs(j.dh.d_m + j.lower), std::abs(j.dh.d_m + j.upper));
+    } else {
+      sum += std::abs(j.dh.d_m);
+    }
+  }
+  if (tool) sum += tool->p.norm();
+  return sum;
+}
+
+double reach_m(const CellRobot& robot) {
+  return reach_m(robot.model, robot.tool);
+}
+
+double shared_volume_m3(double r1_m, double r2_m, double distance_m, std::size_t samples,
+                        std::uint64_t seed) {
+  if (samples == 0 || !(distance_m < r1_m + r2_m)) return 0.0;
+  // Sample the smaller sphere's bounding cube: the common part lies inside it. The larger
+  // sphere's centre is distance_m away along x.
+  const double small = std::min(r1_m, r2_m);
+  const double large = std::max(r1_m, r2_m);
+  // mt19937_64's sequence is fixed by the standard; the conversion to [0, 1) is written out
+  // because uniform_real_distribution's is not.
+  std::mt19937_64 random(seed);
+  const auto uniform = [&random] { return static_cast<double>(random() >> 11) * 0x1.0p-53; };
+  std::size_t inside = 0;
+  for (std::size_t i = 0; i < samples; ++i) {
+    const math::Vec3 p{(2 * uniform() - 1) * small, (2 * uniform() - 1) * small,
+                       (2 * uniform() - 1) * small};
+    const math::Vec3 q = p - math::Vec3{distance_m, 0, 0};
+    if (math::dot(p, p) <= small * small && math::dot(q, q) <= large * large) ++inside;
+  }
+  const double cube = 8.0 * small * small * small;
+  return cube * static_cast<double>(inside) / static_cast<double>(samples);
+}
+
+std::vector<ReachOverlap> reach_overlaps(const CellModel& cell, std::size_t samples) {
+  std::vector<double> reach;
+  for (const CellRobot& r : cell.robots) reach.push_back(reach_m(r));
+  const std::size_t n = cell.robots.size();
+  std::vector<ReachOverlap> out;
+  std::size_t meeting = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t k = i + 1; k < n; ++k) {
+      ReachOverlap o;
+      o.first = i;
+      o.second = k;
+      o.distance_m = (cell.robots[k].base.p - cell.robots[i].base.p).norm();
+      o.depth_m = reach[i] + reach[k] - o.distance_m;
+      if (o.overlaps()) ++meeting;
+      out.push_back(o);
+    }
+  }
+  // At most 2e7 points in all (a thousand robots in one room would otherwise take minutes),
+  // but never fewer than 1000 a pair.
+  constexpr std::size_t kBudget = 20'000'000;
+  const std::size_t per_pair =
+      meeting == 0 ? 0 : std::max<std::size_t>(1000, std::min(samples, kBudget / meeting));
+  for (std::size_t index = 0; index < out.size(); ++index) {
+    ReachOverlap& o = out[index];
+    if (!o.overlaps()) continue;
+    o.shared_volume_m3 = shared_volume_m3(reach[o.first], reach[o.second], o.distance_m,
+                                          std::min(per_pair, samples), 0x5eedce11ULL + index);
+  }
+  return out;
+}
+
+}  // namespace rccx::cell
