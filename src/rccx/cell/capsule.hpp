@@ -1,0 +1,73 @@
+// The narrow phase of the collision check: the distance between two segments and between two
+// capsules (a segment swept by a sphere). Pure functions, noexcept, no allocation.
+#pragma once
+
+#include <algorithm>
+#include <cstdint>
+
+#include "rccx/math/transform.hpp"
+
+namespace rccx::cell {
+
+/// An axis-aligned box, corners in m.
+struct Aabb {
+  math::Vec3 lo_m;
+  math::Vec3 hi_m;
+};
+
+/// True when the boxes are closer than margin_m along every axis (the boxes touch when each is
+/// grown by margin_m / 2).
+[[nodiscard]] inline bool overlap(const Aabb& a, const Aabb& b, double margin_m) noexcept {
+  return a.lo_m.x <= b.hi_m.x + margin_m && b.lo_m.x <= a.hi_m.x + margin_m &&
+         a.lo_m.y <= b.hi_m.y + margin_m && b.lo_m.y <= a.hi_m.y + margin_m &&
+         a.lo_m.z <= b.hi_m.z + margin_m && b.lo_m.z <= a.hi_m.z + margin_m;
+}
+
+/// A capsule in world coordinates: the points within radius_m of the segment p0_m .. p1_m.
+struct Capsule {
+  math::Vec3 p0_m;
+  math::Vec3 p1_m;
+  double radius_m = 0.0;
+  Aabb bounds;            ///< the capsule's box, radius included
+  std::uint8_t link = 0;  ///< the joint that moves it (0-based: DH link link + 1)
+};
+
+/// The box around a capsule.
+[[nodiscard]] inline Aabb bounds_of(const math::Vec3& p0_m, const math::Vec3& p1_m,
+                                    double radius_m) noexcept {
+  const math::Vec3 r{radius_m, radius_m, radius_m};
+  const math::Vec3 lo{std::min(p0_m.x, p1_m.x), std::min(p0_m.y, p1_m.y), std::min(p0_m.z, p1_m.z)};
+  const math::Vec3 hi{std::max(p0_m.x, p1_m.x), std::max(p0_m.y, p1_m.y), std::max(p0_m.z, p1_m.z)};
+  return {lo - r, hi + r};
+}
+
+/// The closest points of two segments.
+struct SegmentClosest {
+  double distance_m = 0.0;
+  double s = 0.0;          ///< fraction along the first segment, 0..1
+  double t = 0.0;          ///< fraction along the second segment, 0..1
+  math::Vec3 on_first_m;   ///< p0 + s (p1 - p0)
+  math::Vec3 on_second_m;  ///< q0 + t (q1 - q0)
+};
+
+/// The closest points of the segments p0..p1 and q0..q1 (Ericson, Real-Time Collision
+/// Detection, 5.1.9). Either segment may be a point, and parallel segments give one of their
+/// closest pairs.
+[[nodiscard]] SegmentClosest segment_distance(const math::Vec3& p0_m, const math::Vec3& p1_m,
+                                              const math::Vec3& q0_m,
+                                              const math::Vec3& q1_m) noexcept;
+
+/// The distance between two capsules and where it is taken.
+struct CapsuleDistance {
+  /// Distance between the surfaces, m; negative when they overlap (by that depth along the
+  /// line of the axes' closest points).
+  double distance_m = 0.0;
+  /// Closest points on each surface, along the line joining the axes' closest points; when the
+  /// axes meet, both are that meeting point.
+  math::Vec3 on_a_m;
+  math::Vec3 on_b_m;
+};
+
+[[nodiscard]] CapsuleDistance capsule_distance(const Capsule& a, const Capsule& b) noexcept;
+
+}  // namespace rccx::cell

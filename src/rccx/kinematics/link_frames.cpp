@@ -1,0 +1,54 @@
+#include "rccx/kinematics/link_frames.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "rccx/math/batch_trig.hpp"
+
+namespace rccx::kin {
+
+DhChain::DhChain(const RobotModel& model) noexcept : dof(std::min(model.dof(), kMaxJoints)) {
+  for (std::size_t i = 0; i < dof; ++i) {
+    const Joint& j = model.joints[i];
+    Link& l = links[i];
+    l = {j.dh.a_m, std::cos(j.dh.alpha_rad), std::sin(j.dh.alpha_rad),
+         j.dh.d_m, j.dh.theta_rad,           j.type == JointType::prismatic};
+    // cos(pi/2) is 6e-17, not 0; snapped as Kinematics does, so both chains agree exactly.
+    if (std::abs(l.cos_alpha) < 1e-15) l.cos_alpha = 0.0;
+    if (std::abs(l.sin_alpha) < 1e-15) l.sin_alpha = 0.0;
+  }
+}
+
+void link_frames(const DhChain& chain, const JointVector& q, std::span<math::Transform> out,
+                 const math::Transform& base) noexcept {
+  const std::size_t n = std::min(chain.dof, out.size());
+  double theta[kMaxJoints] = {}, st[kMaxJoints], ct[kMaxJoints];
+  for (std::size_t i = 0; i < n; ++i) {
+    theta[i] = chain.links[i].theta_rad + (chain.links[i].prismatic ? 0.0 : q[i]);
+  }
+  if (n > 4) {
+    math::sincos8(theta, st, ct);
+  } else {
+    math::sincos4(theta, st, ct);
+  }
+  math::Transform T = base;
+  for (std::size_t i = 0; i < n; ++i) {
+    const DhChain::Link& l = chain.links[i];
+    const double d = l.d_m + (l.prismatic ? q[i] : 0.0);
+    // T A_i multiplied out as in Kinematics::chain_forward.
+    const math::Vec3 nv = T.R.n * ct[i] + T.R.o * st[i];
+    const math::Vec3 v = T.R.o * ct[i] - T.R.n * st[i];
+    const math::Vec3 o = v * l.cos_alpha + T.R.a * l.sin_alpha;
+    const math::Vec3 a = T.R.a * l.cos_alpha - v * l.sin_alpha;
+    T.p += T.R.a * d + nv * l.a_m;
+    T.R = {nv, o, a};
+    out[i] = T;
+  }
+}
+
+void link_frames(const RobotModel& model, const JointVector& q,
+                 std::span<math::Transform> out) noexcept {
+  link_frames(DhChain(model), q, out);
+}
+
+}  // namespace rccx::kin
