@@ -2,10 +2,11 @@
 // its own control and termination, a fixed number of threads whatever their number.
 #include <gtest/gtest.h>
 
+#include <dirent.h>
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cstdlib>
-#include <dirent.h>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -226,4 +227,30 @@ TEST(SessionGroup, MisuseIsRefusedWithAReason) {
   EXPECT_THROW(group.add(*a.drivers[0]), rtc::SessionError);  // after start
   EXPECT_THROW(s.set_period(20ms), rtc::SessionError);
   EXPECT_THROW(rtc::SessionGroup(clock_of(100ms)), rtc::SessionError);
+}
+
+TEST(SessionGroup, TheCycleHookSeesEveryRobotsChgOfItsTick) {
+  Arms a(2);
+  rtc::SessionGroup group(clock_of(10ms));
+  rtc::Session& r0 = group.add(*a.drivers[0]);
+  rtc::Session& r1 = group.add(*a.drivers[1], 2);
+  // Written by the control task only: f2 of each robot, then the hook, in the same tick.
+  auto last_f2 = std::make_shared<std::array<std::uint64_t, 2>>();
+  auto hooked = std::make_shared<std::vector<std::array<std::uint64_t, 3>>>();
+  group.set_cycle_hook([=](std::uint32_t tick) {
+    hooked->push_back({tick, (*last_f2)[0], (*last_f2)[1]});
+  });
+  group.start();
+  r0.control({}, [=](rtc::Control& c) { (*last_f2)[0] = c.how().sample; });
+  r1.control({}, [=](rtc::Control& c) { (*last_f2)[1] = c.how().sample; });
+  group.wait_for(100ms);
+  r0.release();
+  r1.release();
+  ASSERT_GE(hooked->size(), 8U);
+  for (const auto& [tick, s0, s1] : *hooked) {
+    EXPECT_EQ(s0, tick) << "robot 0's f2 of this tick ran before the hook";
+    if ((tick - 1) % 2 == 0) {
+      EXPECT_EQ(s1, tick) << "robot 1 is due at odd ticks";
+    }
+  }
 }

@@ -118,7 +118,8 @@ struct Session::Clock {
   std::atomic<bool> stop{false};
   LatencyHistogram latency;
 
-  std::vector<Session*> sessions;  ///< fixed once the tasks run
+  std::vector<Session*> sessions;                 ///< fixed once the tasks run
+  std::function<void(std::uint32_t)> cycle_hook;  ///< after every f2 of a tick (a group's)
   std::thread communication_thread;
   std::thread control_thread;
   bool running = false;
@@ -215,8 +216,7 @@ Session::Session(Driver& driver, SessionOptions options)
   clock_->start();
 }
 
-Session::Session(Driver& driver, std::shared_ptr<Clock> clock, int multiple,
-                 std::string log_suffix)
+Session::Session(Driver& driver, std::shared_ptr<Clock> clock, int multiple, std::string log_suffix)
     : driver_(driver), clock_(std::move(clock)), multiple_(multiple) {
   open_channel(log_suffix);
 }
@@ -345,11 +345,16 @@ Session& SessionGroup::add(Driver& driver, int multiple) {
     throw SessionError(fmt::format("robot {}: a period multiple of {}; give 1 to 1000",
                                    driver.model().name, multiple));
   }
-  auto s = std::unique_ptr<Session>(
-      new Session(driver, clock_, multiple, "-" + driver.model().name));
+  auto s =
+      std::unique_ptr<Session>(new Session(driver, clock_, multiple, "-" + driver.model().name));
   clock_->sessions.push_back(s.get());
   sessions_.push_back(std::move(s));
   return *sessions_.back();
+}
+
+void SessionGroup::set_cycle_hook(std::function<void(std::uint32_t tick)> hook) {
+  if (clock_->running) throw SessionError("set the cycle hook before start()");
+  clock_->cycle_hook = std::move(hook);
 }
 
 void SessionGroup::start() {
@@ -639,8 +644,7 @@ void Session::Clock::communication_task() noexcept {
       }
       for (Session* s : sessions) {
         if (s->shared_->in_cycle.load(std::memory_order_relaxed) != k) continue;
-        if (!s->comm_->ended &&
-            s->shared_->phase.load(std::memory_order_seq_cst) == kControlling) {
+        if (!s->comm_->ended && s->shared_->phase.load(std::memory_order_seq_cst) == kControlling) {
           if (in_time) {
             s->take_chg(*s->comm_);
           } else {
@@ -703,7 +707,8 @@ void Session::Clock::watchdog(std::uint32_t k, std::int64_t tick_ns) noexcept {
     // real time the check above is the whole story: the cycle finished before this tick was
     // processed, so its Chg was in time.)
     const std::int64_t period = period_ns.load(std::memory_order_relaxed);
-    const std::int64_t used = control_end_ns.load(std::memory_order_relaxed) - last_published_tick_ns;
+    const std::int64_t used =
+        control_end_ns.load(std::memory_order_relaxed) - last_published_tick_ns;
     if (used <= period) return;
     format_text(d, "the control cycle of sample {} took {:.3f} ms of a {:.3f} ms period", cycle,
                 static_cast<double>(used) * 1e-6, static_cast<double>(period) * 1e-6);
@@ -991,6 +996,15 @@ void Session::Clock::control_cycle(std::uint32_t k) noexcept {
   std::int64_t spent_ns = 0;
   for (Session* s : sessions) {
     if (in(s)) spent_ns += s->run_f2();
+  }
+  if (cycle_hook) {
+    try {
+      cycle_hook(k);
+    } catch (...) {
+      for (Session* s : sessions) {
+        if (in(s)) s->request_termination(TerminateCode::control_exception, 0);
+      }
+    }
   }
   const std::int64_t tick_ns = handed_tick_ns.load(std::memory_order_relaxed);
   const std::int64_t end_ns =

@@ -234,6 +234,11 @@ class SessionGroup {
   [[nodiscard]] LatencyStats latency() const;
   /// Simulated time: lets `d` pass for every robot (control of each goes on as it is).
   void wait_for(std::chrono::nanoseconds d);
+  /// A function the control task runs after the f2 of every robot due at a tick, with that
+  /// tick's number (the cell's checks between robots: every robot's next setpoint is known
+  /// then). Only before start(). Like f1 and f2 it must not block; an exception it throws ends
+  /// the control of every robot of the tick with `control_exception`.
+  void set_cycle_hook(std::function<void(std::uint32_t tick)> hook);
 
  private:
   std::shared_ptr<Session::Clock> clock_;
