@@ -22,6 +22,8 @@
 #include "rccx/math/units.hpp"
 #include "rccx/rtc/session.hpp"
 
+#include "shell_run.hpp"
+
 namespace {
 
 using namespace rccx;
@@ -412,23 +414,10 @@ TEST(CellGeometry, ValidateRefusesWhatAFileWould) {
 
 // ---- rccx cell show ----
 
-struct CommandRun {
-  int exit_code = -1;
-  std::string out;
-};
+using CommandRun = rccx::test::ShellRun;
 
 CommandRun run(const std::string& args, bool with_stderr = true) {
-  CommandRun r;
-  const std::string command = std::string(RCCX_CLI) + " " + args + (with_stderr ? " 2>&1" : "");
-  FILE* pipe = popen(command.c_str(), "r");
-  if (pipe == nullptr) return r;
-  std::array<char, 4096> buffer{};
-  while (std::fgets(buffer.data(), static_cast<int>(buffer.size()), pipe) != nullptr) {
-    r.out += buffer.data();
-  }
-  const int status = pclose(pipe);
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-  return r;
+  return rccx::test::rccx_run(args, with_stderr);
 }
 
 TEST(CellCli, ShowListsBothRobots) {

@@ -12,12 +12,11 @@
 #include <string>
 #include <vector>
 
+#include "shell_run.hpp"
+
 namespace {
 
-struct Run {
-  int exit_code = -1;
-  std::string out;  ///< stdout and stderr
-};
+using Run = rccx::test::ShellRun;  // stdout and stderr
 
 /// rccx ARGUMENTS with `input` on stdin.
 Run rccx_with_input(const std::string& arguments, const std::string& input) {
@@ -28,18 +27,9 @@ Run rccx_with_input(const std::string& arguments, const std::string& input) {
   std::fwrite(input.data(), 1, input.size(), f);
   std::fclose(f);
   const std::string command = std::string(RCCX_CLI) + " " + arguments + " < " + path + " 2>&1";
-  Run run;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (pipe != nullptr) {
-    std::array<char, 4096> buffer{};
-    std::size_t n = 0;
-    while ((n = std::fread(buffer.data(), 1, buffer.size(), pipe)) > 0)
-      run.out.append(buffer.data(), n);
-    const int status = pclose(pipe);
-    run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  }
+  const rccx::test::ShellRun r = rccx::test::run_shell(command);
   std::remove(path);
-  return run;
+  return r;
 }
 
 struct Case {

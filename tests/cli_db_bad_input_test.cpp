@@ -24,30 +24,21 @@
 #include "rccx/rccl/position_db.hpp"
 #include "rccx/rccl/position_export.hpp"
 
+#include "shell_run.hpp"
+
 namespace {
 
 namespace fs = std::filesystem;
 using namespace rccx;
 
-struct CliRun {
-  int exit_code = -1;
-  std::string out;  // stdout and stderr
-};
+using CliRun = rccx::test::ShellRun;  // stdout and stderr
 
 /// Runs `rccx ARGUMENTS` through bash (so `ARGUMENTS` may redirect and write bytes as $'\xff').
 CliRun rccx_cli(const std::string& arguments) {
   const std::string command = "exec " + std::string(RCCX_CLI) + " 2>&1 " + arguments;
   ::setenv("RCCX_TEST_COMMAND", command.c_str(), 1);  // no quoting of the command itself
-  CliRun run;
-  FILE* pipe = popen("exec bash -c \"$RCCX_TEST_COMMAND\"", "r");
-  if (pipe == nullptr) return run;
-  std::array<char, 4096> buffer{};
-  while (std::fgets(buffer.data(), static_cast<int>(buffer.size()), pipe) != nullptr) {
-    run.out += buffer.data();
-  }
-  const int status = pclose(pipe);
-  run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return run;
+  const rccx::test::ShellRun r = rccx::test::run_shell("exec bash -c \"$RCCX_TEST_COMMAND\"");
+  return r;
 }
 
 std::string read(const fs::path& file) {

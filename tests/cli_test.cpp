@@ -20,29 +20,17 @@
 #include "rccx/hw/rcu.hpp"
 #include "rccx/kinematics/kinematics.hpp"
 
+#include "shell_run.hpp"
+
 namespace {
 
 using nlohmann::json;
 using namespace rccx;
 
-struct CliRun {
-  int exit_code = -1;
-  std::string out;
-};
+using CliRun = rccx::test::ShellRun;
 
 CliRun rccx_cli(const std::string& arguments, bool with_stderr = true) {
-  const std::string command =
-      std::string(RCCX_CLI) + " " + arguments + (with_stderr ? " 2>&1" : " 2>/dev/null");
-  CliRun run;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (pipe == nullptr) return run;
-  std::array<char, 4096> buffer{};
-  while (std::fgets(buffer.data(), static_cast<int>(buffer.size()), pipe) != nullptr) {
-    run.out += buffer.data();
-  }
-  const int status = pclose(pipe);
-  run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return run;
+  return rccx::test::rccx_run(arguments, with_stderr);
 }
 
 std::string pose_argument(const math::Transform& T) {

@@ -182,7 +182,8 @@ TEST(SessionGroup, ThreadsDoNotGrowWithTheNumberOfRobots) {
     for (std::size_t i = 0; i < g.size(); ++i) g[i].release();
   }
   EXPECT_EQ(with_many, with_two);
-  EXPECT_LE(with_many, 3U) << "the two tasks, and the Ctrl-C watcher";
+  // The two tasks and the Ctrl-C watcher (ThreadSanitizer adds one of its own).
+  EXPECT_LE(with_many, 4U);
 }
 
 TEST(SessionGroup, EachRobotHasItsOwnEnvironmentLog) {

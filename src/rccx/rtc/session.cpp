@@ -1014,6 +1014,22 @@ void Session::Clock::control_cycle(std::uint32_t k) noexcept {
   ring(planning_bell);
 }
 
+// A control function that throws ends this robot's control with `control_exception`, its
+// message as rtc_message; nothing escapes into the control task.
+void Session::run_guarded(ControlFunction& f) noexcept {
+  if (!f) return;
+  Control& ctl = shared_->control;
+  try {
+    f(ctl);
+  } catch (const std::exception& e) {
+    ctl.message(e.what());
+    request_termination(TerminateCode::control_exception, 0);
+  } catch (...) {
+    ctl.message("unknown exception");
+    request_termination(TerminateCode::control_exception, 0);
+  }
+}
+
 void Session::run_f1(std::uint32_t k) noexcept {
   (void)k;
   Shared& s = *shared_;
@@ -1021,34 +1037,14 @@ void Session::run_f1(std::uint32_t k) noexcept {
   ctl.how_ = s.how;
   ctl.period_s_ = std::chrono::duration<double>(period()).count();
   ctl.spent_ns_ = 0;
-  if (f1_) {
-    try {
-      f1_(ctl);
-    } catch (const std::exception& e) {
-      ctl.message(e.what());
-      request_termination(TerminateCode::control_exception, 0);
-    } catch (...) {
-      ctl.message("unknown exception");
-      request_termination(TerminateCode::control_exception, 0);
-    }
-  }
+  run_guarded(f1_);
   s.chg = ctl.chg_;
 }
 
 std::int64_t Session::run_f2() noexcept {
   Control& ctl = shared_->control;
   ctl.chg_.clear_commands();
-  if (f2_) {
-    try {
-      f2_(ctl);
-    } catch (const std::exception& e) {
-      ctl.message(e.what());
-      request_termination(TerminateCode::control_exception, 0);
-    } catch (...) {
-      ctl.message("unknown exception");
-      request_termination(TerminateCode::control_exception, 0);
-    }
-  }
+  run_guarded(f2_);
   return ctl.spent_ns_;
 }
 

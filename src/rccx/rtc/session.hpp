@@ -179,6 +179,7 @@ class Session {
   void take_chg(CommState& c) noexcept;
   void apply(CommState& c, const Chg& chg) noexcept;
   void end_control(CommState& c, TerminateCode code, int joint, std::string_view detail) noexcept;
+  void run_guarded(ControlFunction& f) noexcept;
   void run_f1(std::uint32_t k) noexcept;
   std::int64_t run_f2() noexcept;
   void request_termination(TerminateCode code, int joint) noexcept;
