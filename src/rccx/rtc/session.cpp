@@ -117,6 +117,8 @@ struct Session::Clock {
   std::atomic<bool> control_busy{false};
   std::atomic<bool> stop{false};
   LatencyHistogram latency;
+  LatencyHistogram compute;  ///< each tick: its start to the end of its control cycle
+  std::atomic<std::int64_t> tick_started_ns{0};  ///< monotonic: the communication task woke
 
   std::vector<Session*> sessions;                 ///< fixed once the tasks run
   std::function<void(std::uint32_t)> cycle_hook;  ///< after every f2 of a tick (a group's)
@@ -370,6 +372,10 @@ LatencyStats SessionGroup::latency() const {
   return clock_->latency.stats();
 }
 
+LatencyStats SessionGroup::compute() const {
+  return clock_->compute.stats();
+}
+
 void SessionGroup::wait_for(std::chrono::nanoseconds d) {
   if (sessions_.empty() || !clock_->running) throw SessionError("start() the group first");
   sessions_.front()->wait_for(d);
@@ -614,6 +620,8 @@ void Session::Clock::communication_task() noexcept {
   for (std::uint32_t k = 1;; ++k) {
     std::int64_t tick_ns = 0;
     if (!wait_tick(k, next_deadline, tick_ns)) return;
+    const std::int64_t started = monotonic_ns();
+    tick_started_ns.store(started, std::memory_order_relaxed);
     watchdog(k, tick_ns);
 
     bool handed = false;
@@ -657,6 +665,8 @@ void Session::Clock::communication_task() noexcept {
       }
       chg_taken.store(k, std::memory_order_release);
       ring(control_bell);
+    } else {
+      compute.record(monotonic_ns() - started);  // no control this tick: reading was all
     }
     comm_done.store(k, std::memory_order_release);
     ring(planning_bell);
@@ -1010,6 +1020,7 @@ void Session::Clock::control_cycle(std::uint32_t k) noexcept {
   const std::int64_t end_ns =
       simulated() ? tick_ns + spent_ns : std::max(monotonic_ns() - t0_ns, tick_ns);
   control_end_ns.store(end_ns, std::memory_order_relaxed);
+  compute.record(monotonic_ns() - tick_started_ns.load(std::memory_order_relaxed));
   control_done.store(k, std::memory_order_release);  // the watchdog kick
   ring(planning_bell);
 }

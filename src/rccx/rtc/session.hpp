@@ -233,6 +233,10 @@ class SessionGroup {
   /// The base period of the clock.
   [[nodiscard]] std::chrono::nanoseconds period() const noexcept;
   [[nodiscard]] LatencyStats latency() const;
+  /// Computing time of each tick, wall clock (simulated or real time): from the communication
+  /// task's wake-up to the end of the tick's control cycle (every robot read, checked, f1 and
+  /// f2 run, commands sent). `wakeups` counts the ticks; `missed_deadlines` stays 0.
+  [[nodiscard]] LatencyStats compute() const;
   /// Simulated time: lets `d` pass for every robot (control of each goes on as it is).
   void wait_for(std::chrono::nanoseconds d);
   /// A function the control task runs after the f2 of every robot due at a tick, with that
