@@ -44,7 +44,7 @@ double Cell::braking_m(const kin::RobotModel& model, const kin::JointVector& q0,
   }
   double d = 0.0;
   for (std::size_t j = 0; j < n; ++j) {
-    const double travel = v[j] * (Ts / 2.0 + 2.0 * period_s);
+    const double travel = v[j] * (Ts / 2.0 + period_s);
     d += model.joints[j].type == kin::JointType::prismatic ? travel : travel * lever_m[j];
   }
   return d;
@@ -52,13 +52,17 @@ double Cell::braking_m(const kin::RobotModel& model, const kin::JointVector& q0,
 
 kin::JointVector Cell::levers_m(const CellRobot& robot) {
   const kin::RobotModel& m = robot.model;
-  const double radius = *std::max_element(robot.link_radius_m.begin(), robot.link_radius_m.end());
   kin::JointVector lever(m.dof());
   // Joint j's axis passes through frame j-1's origin, where link j begins: every point of the
-  // links it moves is within their lengths of it.
-  double beyond = (robot.tool ? robot.tool->p.norm() : 0.0) + radius;
+  // links it moves is within their lengths of it, their capsules' surfaces a radius further.
+  double beyond = robot.tool ? robot.tool->p.norm() : 0.0;
+  double radius = 0.0;
   for (std::size_t j = m.dof(); j-- > 0;) {
     const kin::Joint& k = m.joints[j];
+    const double r = robot.link_radius_m.size() == m.dof() ? robot.link_radius_m[j]
+                                                           : robot.link_radius_m.front();
+    beyond += std::max(r - radius, 0.0);  // the widest capsule so far counts once
+    radius = std::max(radius, r);
     beyond += std::abs(k.dh.a_m);
     beyond += k.type == kin::JointType::prismatic
                   ? std::max(std::abs(k.dh.d_m + k.lower), std::abs(k.dh.d_m + k.upper))

@@ -125,10 +125,11 @@ class Cell {
 
   /// A bound on how far any point of a robot's links (and capsules) travels from setpoint q1
   /// (with q0 the setpoint one period P before) until it stands, when asked to stop now: the
-  /// generator's halt decelerates every joint at its bound a_j within one common time, and the
-  /// stop may begin one setpoint later, so with v_j = |q1_j - q0_j| / P + a_j P (a step's speed
-  /// change included) and Ts = max v_j / a_j, joint j travels at most v_j (Ts / 2 + 2 P) and a
-  /// point moves at most lever_m[j] per rad of it (1 m per m of a prismatic joint), m.
+  /// generator's halt decelerates every joint at its bound a_j within one common time. The check
+  /// passes q1 only when the pair stays apart by this much, so that the stop may still begin
+  /// one setpoint later, from q2: with v_j = |q1_j - q0_j| / P + a_j P (q2's speed at most)
+  /// and Ts = max v_j / a_j, joint j travels at most v_j P to q2 and v_j Ts / 2 while it stops,
+  /// and a point moves at most lever_m[j] per rad of it (1 m per m of a prismatic joint), m.
   static double braking_m(const kin::RobotModel& model, const kin::JointVector& q0,
                           const kin::JointVector& q1, const kin::JointVector& max_acceleration,
                           double period_s, const kin::JointVector& lever_m) noexcept;
