@@ -7,7 +7,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -199,6 +198,7 @@ TEST(CellRuntime, TheMicroboFollowsAFrameThePumaMoves) {
     travel_m = std::max(travel_m, std::abs(follower[i].p.y));
     ++compared;
   }
+  RecordProperty("worst_mm", std::to_string(worst_m * 1e3));
   EXPECT_GT(compared, 100U);
   EXPECT_GT(travel_m, 0.029) << "the follower did not move with the leader";
   EXPECT_LT(worst_m, 1e-3) << "commanded tool points apart by up to " << worst_m * 1e3 << " mm";
@@ -224,6 +224,7 @@ TEST(CellRuntime, TwoArmsDrivenTowardsEachOtherStopOutsideTheMargin) {
   c->wait_for(1s);  // both stand
   EXPECT_GE(c->collision_stops(), 1U);
   EXPECT_GE(closest_m, margin_m) << "capsules came within the margin";
+  RecordProperty("closest_mm", std::to_string(closest_m * 1e3));
   for (rccl::Manipulator* m : {&puma, &microbo}) {
     ASSERT_FALSE(m->failures().empty());
     const std::string msg(m->failures().front().message());

@@ -192,7 +192,7 @@ rccl::TransformPtr Cell::tool_frame(std::string_view leader) const {
     const double dt = ctx.t_s - s.t_s;
     if (ctx.how == nullptr || !(std::abs(dt) < 0.25)) return s.pose;
     math::Transform p = s.pose;
-    p.p = p.p + s.velocity_m_per_s * dt;
+    p.p = p.p + s.velocity_m_per_s * dt + s.acceleration_m_per_s2 * (dt * dt / 2.0);
     p.R = rotate(p.R, s.angular_velocity_rad_s, dt);
     return p;
   });
@@ -240,7 +240,12 @@ void Cell::on_cycle(std::uint32_t tick) noexcept {
     s.t_s = t;
     const double dt = t - r.last_t_s;
     if (r.valid && dt > 0.0) {
-      s.velocity_m_per_s = (s.pose.p - before.pose.p) * (1.0 / dt);
+      // Differences of the setpoints: the backward difference is the velocity half a period
+      // back; the change of it over the period, the acceleration.
+      const math::Vec3 v_back = (s.pose.p - before.pose.p) * (1.0 / dt);
+      s.acceleration_m_per_s2 = (v_back - r.velocity_back) * (1.0 / dt);
+      s.velocity_m_per_s = v_back + s.acceleration_m_per_s2 * (dt / 2.0);
+      r.velocity_back = v_back;
       math::Vec3 axis;
       double angle = 0.0;
       (s.pose.R * before.pose.R.transposed()).to_axis_angle(axis, angle);

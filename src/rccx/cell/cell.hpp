@@ -15,8 +15,9 @@
 //   T6 TOOL = BASE_INV(microbo) PUMA_TOOL GRASP      the Microbo follows what the PUMA holds
 //
 // The control task publishes every robot's commanded T6 TOOL (in the world, with its linear
-// and angular velocity) after each tick through a seqlock; a reader extrapolates it to the
-// time its own setpoint is for, so a follower sampled at another rate does not lag.
+// velocity and acceleration and its angular velocity) after each tick through a seqlock; a
+// reader extrapolates it to the time its own setpoint is for (up to its pipeline of two
+// periods ahead), so a follower sampled at another rate does not lag.
 //
 // Safety between arms: after every tick the control task puts every robot's next setpoint
 // into a CollisionWorld (capsules per link, the cell's margin) and, when two robots' capsules
@@ -61,6 +62,7 @@ struct CellOptions {
 struct ToolSample {
   math::Transform pose;               ///< world <- T6 TOOL, m
   math::Vec3 velocity_m_per_s;        ///< of pose.p
+  math::Vec3 acceleration_m_per_s2;   ///< of pose.p
   math::Vec3 angular_velocity_rad_s;  ///< of pose.R, world frame
   double t_s = 0.0;                   ///< the time the setpoint is for, s
 };
@@ -153,6 +155,7 @@ class Cell {
     double last_t_s = -1.0;  ///< the setpoint time last published
     bool valid = false;      ///< has a setpoint in the collision world
     double braking_m = 0.0;
+    math::Vec3 velocity_back;  ///< the tool point's last backward difference, m/s
   };
 
   [[nodiscard]] const Robot& find(std::string_view name) const;
