@@ -73,7 +73,9 @@ kin::JointVector Cell::levers_m(const CellRobot& robot) {
 }
 
 Cell::Cell(CellModel model, CellOptions options)
-    : model_(std::move(model)), options_(options), group_(group_options(model_, options_)) {
+    : model_(std::move(model)),
+      options_(options),
+      group_(std::make_unique<rtc::SessionGroup>(group_options(model_, options_))) {
   validate(model_);
   std::vector<RobotCapsules> capsules;
   double widest_allowance_m = 0.0;
@@ -82,7 +84,7 @@ Cell::Cell(CellModel model, CellOptions options)
     auto r = std::make_unique<Robot>();
     r->name = cr.name;
     r->hardware = rtc::make_simulated_hardware(cr.model);
-    r->session = &group_.add(*r->hardware.driver, static_cast<int>(cr.period_multiple));
+    r->session = &group_->add(*r->hardware.driver, static_cast<int>(cr.period_multiple));
     r->manipulator = std::make_unique<rccl::Manipulator>(*r->session);
     r->base_inverse = cr.base.inverse();
     r->tool = cr.tool.value_or(math::Transform::identity());
@@ -110,7 +112,7 @@ Cell::Cell(CellModel model, CellOptions options)
   contacts_.resize(n * (n - 1) / 2 + 1);
   last_distance_m_.assign(n * n, kInf);
   seen_.assign(n * n, 0);
-  group_.set_cycle_hook([this](std::uint32_t tick) { on_cycle(tick); });
+  group_->set_cycle_hook([this](std::uint32_t tick) { on_cycle(tick); });
 }
 
 std::unique_ptr<Cell> Cell::load(const std::filesystem::path& path, CellOptions options) {
@@ -118,20 +120,26 @@ std::unique_ptr<Cell> Cell::load(const std::filesystem::path& path, CellOptions 
 }
 
 Cell::~Cell() {
-  // Every robot's control first (the manipulators release their sessions), then the group's
-  // tasks (group_'s destructor), then the hardware (robots_, declared before the group).
-  for (auto& r : robots_) r->manipulator.reset();
+  // Every robot's control first, then the group's tasks, so that the cycle hook has stopped
+  // before the manipulators (which it reads) and the hardware go.
+  for (auto& r : robots_) {
+    try {
+      r->manipulator->stop_control();
+    } catch (...) {  // nothing sensible to do in a destructor
+    }
+  }
+  group_.reset();
 }
 
 void Cell::start() {
   if (started_) throw rtc::SessionError("the cell has started already");
-  group_.start();
+  group_->start();
   for (auto& r : robots_) r->manipulator->start();
   started_ = true;
 }
 
 void Cell::wait_for(std::chrono::nanoseconds d) {
-  group_.wait_for(d);
+  group_->wait_for(d);
 }
 
 const Cell::Robot& Cell::find(std::string_view name) const {

@@ -95,7 +95,7 @@ class Cell {
   /// The index of a robot in the model (the order of the cell file); throws like robot().
   [[nodiscard]] std::size_t index(std::string_view name) const;
   [[nodiscard]] const CellModel& model() const noexcept { return model_; }
-  [[nodiscard]] rtc::SessionGroup& group() noexcept { return group_; }
+  [[nodiscard]] rtc::SessionGroup& group() noexcept { return *group_; }
 
   // --- Frames across robots ------------------------------------------------------------------
   /// world <- the robot's base frame, m.
@@ -174,7 +174,8 @@ class Cell {
   std::array<char, rccl::kEventText> message_{};
   std::function<void(std::uint32_t)> observer_;
   std::atomic<std::uint64_t> collision_stops_{0};
-  rtc::SessionGroup group_;
+  /// Last: its tasks (and the cycle hook) stop first, see ~Cell.
+  std::unique_ptr<rtc::SessionGroup> group_;
   bool started_ = false;
 };
 
