@@ -257,7 +257,7 @@ void Manipulator::drain() {
   while (auto e = generator_->next_event()) {
     if (e->kind == EventKind::failed || e->kind == EventKind::cancelled) {
       failures_.push_back(*e);
-      failed_ids_.insert(e->id);
+      if (e->id != 0) failed_ids_.insert(e->id);  // 0: a stop of tracking, no motion
     }
     pending_events_.push_back(*e);
   }

@@ -707,6 +707,13 @@ void TrajectoryGenerator::fail(std::uint64_t id, const SampleContext& ctx, kin::
   start_halt();
 }
 
+void TrajectoryGenerator::request_stop(std::string_view why) noexcept {
+  const std::size_t n = std::min(why.size(), kEventText - 1);
+  std::copy_n(why.data(), n, stop_text_.data());
+  stop_text_[n] = '\0';
+  stop_requested_ = true;
+}
+
 void TrajectoryGenerator::start_halt() noexcept {
   const double P = options_.period_s;
   halt_ = Halt{};
@@ -759,6 +766,7 @@ void TrajectoryGenerator::reset(const JointVector& q, double t_s) noexcept {
   tr_ = Transition{};
   halt_ = Halt{};
   halt_requested_.store(false);
+  stop_requested_ = false;
   rest_at(q);
   last_q_ = prev_q_ = q;
   last_t_ = t_s - options_.period_s;
@@ -779,6 +787,18 @@ std::uint64_t TrajectoryGenerator::step(const SampleContext& ctx, const JointVec
   if (halt_requested_.exchange(false, std::memory_order_acq_rel) && !at_rest()) {
     const std::uint64_t id = cur_.id != 0 ? cur_.id : (has_next_ ? next_.id : 0);
     fail(id, ctx, kin::IkStatus::ok, 0, text("halted by the program"));
+  }
+  if (stop_requested_) {
+    stop_requested_ = false;
+    const bool tracking = cur_.kind == Segment::Kind::cartesian && cur_.resting;
+    if (!halt_.active && !at_rest()) {
+      const std::uint64_t id = cur_.id != 0 ? cur_.id : (has_next_ ? next_.id : 0);
+      fail(id, ctx, kin::IkStatus::ok, 0, stop_text_);
+    } else if (!halt_.active && tracking) {
+      // Its motion has ended already: no motion to fail, only the tracking to stop.
+      emit(EventKind::failed, 0, ctx, kin::IkStatus::ok, 0, std::string_view(stop_text_.data()));
+      start_halt();
+    }
   }
   if (!waiting_) {
     MotionRequest r;

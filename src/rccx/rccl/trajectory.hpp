@@ -153,6 +153,19 @@ class TrajectoryGenerator {
                      kin::JointVector& q);
   [[nodiscard]] bool at_rest() const noexcept;
   [[nodiscard]] const kin::Kinematics& kinematics() const noexcept { return kin_; }
+  [[nodiscard]] const GeneratorOptions& options() const noexcept { return options_; }
+
+  // --- Sample loop, between steps (the control thread only: f2, a SessionGroup cycle hook) --
+  /// The last setpoint step() returned (rad / m; empty before the first reset) and the one
+  /// before it, and the time the last is for (s): what goes out to the arm next.
+  [[nodiscard]] const kin::JointVector& last_setpoint() const noexcept { return last_q_; }
+  [[nodiscard]] const kin::JointVector& previous_setpoint() const noexcept { return prev_q_; }
+  [[nodiscard]] double last_setpoint_time_s() const noexcept { return last_t_; }
+  /// Asks the next step() to stop smoothly (each joint within its acceleration bound) when the
+  /// arm moves - a motion, a transition, or a Cartesian rest tracking a moving goal - failing
+  /// the motion with `why` (truncated to kEventText - 1 characters) and cancelling the queue.
+  /// Ignored when the arm is at rest or already stopping. What a cell's collision check uses.
+  void request_stop(std::string_view why) noexcept;
 
  private:
   struct Segment {
@@ -252,6 +265,8 @@ class TrajectoryGenerator {
   boost::lockfree::spsc_queue<MotionRequest, boost::lockfree::capacity<kQueueCapacity>> requests_;
   boost::lockfree::spsc_queue<MotionEvent, boost::lockfree::capacity<4 * kQueueCapacity>> events_;
   std::atomic<bool> halt_requested_{false};
+  bool stop_requested_ = false;  ///< request_stop(): same thread as step()
+  Text stop_text_{};
   std::atomic<std::uint64_t> started_{0}, ended_{0};
   std::array<SegmentReport, kReports> reports_{};
 

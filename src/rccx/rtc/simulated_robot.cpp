@@ -10,20 +10,30 @@ std::chrono::nanoseconds SimulatedRobot::usual_period(const kin::RobotModel& mod
   return model.hardware_json.empty() ? milliseconds(10) : milliseconds(28);
 }
 
+SimulatedHardware make_simulated_hardware(const kin::RobotModel& model, bool calibrated) {
+  SimulatedHardware h;
+  hw::SimulatedArmOptions arm_options;
+  arm_options.calibrated = calibrated;
+  if (!model.hardware_json.empty()) {
+    h.rcu = std::make_unique<hw::Rcu>(model, arm_options);
+    h.bus = std::make_unique<hw::RcuBus>(*h.rcu);
+    MicroboDriverOptions o;
+    for (std::size_t j = 0; j < model.dof(); ++j) o.work_areas[j] = h.rcu->work_area(j);
+    h.driver = std::make_unique<MicroboDriver>(model, *h.bus, *h.rcu, o);
+  } else {
+    h.arm = hw::make_simulated_arm(model, arm_options);
+    h.driver = std::make_unique<ServoDriver>(*h.arm);
+  }
+  return h;
+}
+
 SimulatedRobot::SimulatedRobot(kin::RobotModel m, const SimulatedRobotOptions& options)
     : model(std::move(m)) {
-  hw::SimulatedArmOptions arm_options;
-  arm_options.calibrated = options.calibrated;
-  if (!model.hardware_json.empty()) {
-    rcu = std::make_unique<hw::Rcu>(model, arm_options);
-    bus = std::make_unique<hw::RcuBus>(*rcu);
-    MicroboDriverOptions o;
-    for (std::size_t j = 0; j < model.dof(); ++j) o.work_areas[j] = rcu->work_area(j);
-    driver = std::make_unique<MicroboDriver>(model, *bus, *rcu, o);
-  } else {
-    arm = hw::make_simulated_arm(model, arm_options);
-    driver = std::make_unique<ServoDriver>(*arm);
-  }
+  SimulatedHardware h = make_simulated_hardware(model, options.calibrated);
+  arm = std::move(h.arm);
+  rcu = std::move(h.rcu);
+  bus = std::move(h.bus);
+  driver = std::move(h.driver);
   SessionOptions so;
   so.period = options.period.count() > 0 ? options.period : usual_period(model);
   so.clock = options.clock;

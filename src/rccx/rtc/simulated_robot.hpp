@@ -26,6 +26,19 @@ struct SimulatedRobotOptions {
   std::filesystem::path log;  ///< a CSV of every controlled sample; empty: none (or RCCX_LOG)
 };
 
+/// The part below the session: the simulated arm (or the Microbo's RCU and its bus) and the
+/// driver over it. What a SimulatedRobot and each robot of a cell are built on.
+struct SimulatedHardware {
+  std::unique_ptr<hw::SimulatedArm> arm;  ///< servo arms
+  std::unique_ptr<hw::Rcu> rcu;           ///< the Microbo
+  std::unique_ptr<hw::RcuBus> bus;
+  std::unique_ptr<Driver> driver;
+};
+
+/// Builds the hardware and driver of `model` (the Microbo's RCU when the robot file describes
+/// one, else a servo arm). Throws std::invalid_argument when the robot cannot be simulated.
+SimulatedHardware make_simulated_hardware(const kin::RobotModel& model, bool calibrated = true);
+
 struct SimulatedRobot {
   /// Throws std::invalid_argument when the robot cannot be simulated, SessionError for a bad
   /// period, LogError for a log file that cannot be written.

@@ -1,0 +1,312 @@
+#include "rccx/cell/cell.hpp"
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+namespace rccx::cell {
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+rtc::SessionOptions group_options(const CellModel& m, const CellOptions& o) {
+  rtc::SessionOptions so;
+  so.period = m.base_period;
+  so.clock = o.clock;
+  so.real_time_scheduling = o.real_time_scheduling;
+  return so;
+}
+
+/// R(dt) from angular velocity w (world frame) applied to R.
+math::Rot3 rotate(const math::Rot3& R, const math::Vec3& w, double dt) noexcept {
+  const double rate = w.norm();
+  if (!(rate * std::abs(dt) > 1e-12)) return R;
+  return math::Rot3::about(w * (1.0 / rate), rate * dt) * R;
+}
+
+}  // namespace
+
+double Cell::braking_m(const kin::RobotModel& model, const kin::JointVector& q0,
+                       const kin::JointVector& q1, const kin::JointVector& max_acceleration,
+                       double period_s, const kin::JointVector& lever_m) noexcept {
+  const std::size_t n =
+      std::min({q0.size(), q1.size(), max_acceleration.size(), lever_m.size(), model.dof()});
+  std::array<double, kin::kMaxJoints> v{};
+  double Ts = 0.0;
+  for (std::size_t j = 0; j < n; ++j) {
+    v[j] = std::abs(q1[j] - q0[j]) / period_s + max_acceleration[j] * period_s;
+    Ts = std::max(Ts, v[j] / max_acceleration[j]);
+  }
+  double d = 0.0;
+  for (std::size_t j = 0; j < n; ++j) {
+    const double travel = v[j] * (Ts / 2.0 + period_s);
+    d += model.joints[j].type == kin::JointType::prismatic ? travel : travel * lever_m[j];
+  }
+  return d;
+}
+
+kin::JointVector Cell::levers_m(const CellRobot& robot) {
+  const kin::RobotModel& m = robot.model;
+  kin::JointVector lever(m.dof());
+  // Joint j's axis passes through frame j-1's origin, where link j begins: every point of the
+  // links it moves is within their lengths of it, their capsules' surfaces a radius further.
+  double beyond = robot.tool ? robot.tool->p.norm() : 0.0;
+  double radius = 0.0;
+  for (std::size_t j = m.dof(); j-- > 0;) {
+    const kin::Joint& k = m.joints[j];
+    const double r = robot.link_radius_m.size() == m.dof() ? robot.link_radius_m[j]
+                                                           : robot.link_radius_m.front();
+    beyond += std::max(r - radius, 0.0);  // the widest capsule so far counts once
+    radius = std::max(radius, r);
+    beyond += std::abs(k.dh.a_m);
+    beyond += k.type == kin::JointType::prismatic
+                  ? std::max(std::abs(k.dh.d_m + k.lower), std::abs(k.dh.d_m + k.upper))
+                  : std::abs(k.dh.d_m);
+    lever[j] = beyond;
+  }
+  return lever;
+}
+
+Cell::Cell(CellModel model, CellOptions options)
+    : model_(std::move(model)),
+      options_(options),
+      group_(std::make_unique<rtc::SessionGroup>(group_options(model_, options_))) {
+  validate(model_);
+  std::vector<RobotCapsules> capsules;
+  double widest_allowance_m = 0.0;
+  for (std::size_t i = 0; i < model_.robots.size(); ++i) {
+    const CellRobot& cr = model_.robots[i];
+    auto r = std::make_unique<Robot>();
+    r->name = cr.name;
+    r->hardware = rtc::make_simulated_hardware(cr.model);
+    r->session = &group_->add(*r->hardware.driver, static_cast<int>(cr.period_multiple));
+    r->manipulator = std::make_unique<rccl::Manipulator>(*r->session);
+    r->base_inverse = cr.base.inverse();
+    r->tool = cr.tool.value_or(math::Transform::identity());
+    r->period_s = std::chrono::duration<double>(model_.period(i)).count();
+    r->lever_m = levers_m(cr);
+    capsules.emplace_back(cr.model, cr.link_radius_m, cr.base);
+    // Before its first setpoint a robot's tool frame is its ready pose.
+    const kin::JointVector ready = cr.model.ready();
+    ToolSample s;
+    s.pose = cr.base * r->manipulator->kinematics().forward(ready) * r->tool;
+    r->published.store(s);
+    // The largest allowance a robot can need: at its top speeds.
+    const rccl::GeneratorOptions& g = r->manipulator->generator().options();
+    kin::JointVector q1 = ready;
+    for (std::size_t j = 0; j < q1.size(); ++j) q1[j] += g.max_velocity[j] * r->period_s;
+    widest_allowance_m +=
+        braking_m(cr.model, ready, q1, g.max_acceleration, r->period_s, r->lever_m);
+    robots_.push_back(std::move(r));
+  }
+  // The world reports every pair that could need a stop; on_cycle compares each with the
+  // margin plus the two robots' allowances at that tick.
+  world_ = std::make_unique<CollisionWorld>(std::move(capsules),
+                                            model_.collision_margin_m + widest_allowance_m);
+  const std::size_t n = robots_.size();
+  contacts_.resize(n * (n - 1) / 2 + 1);
+  last_distance_m_.assign(n * n, kInf);
+  seen_.assign(n * n, 0);
+  group_->set_cycle_hook([this](std::uint32_t tick) { on_cycle(tick); });
+}
+
+std::unique_ptr<Cell> Cell::load(const std::filesystem::path& path, CellOptions options) {
+  return std::make_unique<Cell>(load_cell_file(path), options);
+}
+
+Cell::~Cell() {
+  // Every robot's control first, then the group's tasks, so that the cycle hook has stopped
+  // before the manipulators (which it reads) and the hardware go.
+  for (auto& r : robots_) {
+    try {
+      r->manipulator->stop_control();
+    } catch (...) {  // nothing sensible to do in a destructor
+    }
+  }
+  group_.reset();
+}
+
+void Cell::start() {
+  if (started_) throw rtc::SessionError("the cell has started already");
+  group_->start();
+  for (auto& r : robots_) r->manipulator->start();
+  started_ = true;
+}
+
+void Cell::wait_for(std::chrono::nanoseconds d) {
+  group_->wait_for(d);
+}
+
+const Cell::Robot& Cell::find(std::string_view name) const {
+  return *robots_[index(name)];
+}
+Cell::Robot& Cell::find(std::string_view name) {
+  return *robots_[index(name)];
+}
+
+std::size_t Cell::index(std::string_view name) const {
+  for (std::size_t i = 0; i < robots_.size(); ++i) {
+    if (robots_[i]->name == name) return i;
+  }
+  throw std::invalid_argument(fmt::format("cell {}: no robot \"{}\"; its robots: {}", model_.name,
+                                          name, fmt::join(robot_names(), ", ")));
+}
+
+rccl::Manipulator& Cell::robot(std::string_view name) {
+  return *find(name).manipulator;
+}
+rtc::Session& Cell::session(std::string_view name) {
+  return *find(name).session;
+}
+rtc::SimulatedHardware& Cell::hardware(std::string_view name) {
+  return find(name).hardware;
+}
+
+std::vector<std::string> Cell::robot_names() const {
+  std::vector<std::string> names;
+  for (const auto& r : robots_) names.push_back(r->name);
+  return names;
+}
+
+const math::Transform& Cell::base(std::string_view name) const {
+  return model_.robots[index(name)].base;
+}
+
+math::Transform Cell::world_to_base(std::string_view name,
+                                    const math::Transform& world_pose) const {
+  return find(name).base_inverse * world_pose;
+}
+
+ToolSample Cell::tool_sample(std::string_view name) const {
+  ToolSample s;
+  find(name).published.load(s);
+  return s;
+}
+
+rccl::TransformPtr Cell::tool_frame(std::string_view leader) const {
+  const Robot* r = &find(leader);
+  // The Robot outlives the transform only while the cell lives: a transform used after the
+  // cell is gone is a misuse, as a session's would be.
+  return rccl::functional(r->name + "_TOOL", [r](const rccl::SampleContext& ctx) {
+    ToolSample s;
+    r->published.load(s);
+    // Extrapolated to the time the reader's setpoint is for (a follower sampled more slowly,
+    // or later in the tick); a reader without a time (the planning level) takes it as it is.
+    const double dt = ctx.t_s - s.t_s;
+    if (ctx.how == nullptr || !(std::abs(dt) < 0.25)) return s.pose;
+    math::Transform p = s.pose;
+    p.p = p.p + s.velocity_m_per_s * dt + s.acceleration_m_per_s2 * (dt * dt / 2.0);
+    p.R = rotate(p.R, s.angular_velocity_rad_s, dt);
+    return p;
+  });
+}
+
+rccl::TransformPtr Cell::in_base_of(std::string_view robot,
+                                    const rccl::TransformPtr& world_transform) const {
+  const Robot& r = find(robot);
+  const std::string name = world_transform->name() + "_in_" + r.name;
+  switch (world_transform->kind()) {
+    case rccl::TransformKind::constant:
+      return rccl::constant(name, r.base_inverse * world_transform->value());
+    case rccl::TransformKind::functional:
+      return rccl::functional(
+          name, [b = r.base_inverse, t = world_transform](const rccl::SampleContext& ctx) {
+            return b * t->value_now(ctx);
+          });
+    case rccl::TransformKind::hold:
+    case rccl::TransformKind::t6:
+      break;
+  }
+  throw std::invalid_argument(fmt::format(
+      "in_base_of({}, {}): a {} transform cannot be re-expressed; use a constant or functional one",
+      robot, world_transform->name(), rccl::to_string(world_transform->kind())));
+}
+
+void Cell::set_cycle_observer(std::function<void(std::uint32_t)> observer) {
+  if (started_) throw rtc::SessionError("set_cycle_observer: only before start()");
+  observer_ = std::move(observer);
+}
+
+void Cell::on_cycle(std::uint32_t tick) noexcept {
+  for (std::size_t i = 0; i < robots_.size(); ++i) {
+    Robot& r = *robots_[i];
+    const rccl::TrajectoryGenerator& g = r.manipulator->generator();
+    const kin::JointVector& q = g.last_setpoint();
+    if (q.size() != model_.robots[i].model.dof()) continue;  // no setpoint yet
+    const double t = g.last_setpoint_time_s();
+    if (r.valid && t == r.last_t_s) continue;  // not due this tick: nothing new
+    // The tool frame, for followers: velocities from the last two published samples.
+    ToolSample before;
+    r.published.load(before);  // this thread is the only writer: never waits
+    ToolSample s;
+    s.pose = model_.robots[i].base * r.manipulator->kinematics().forward(q) * r.tool;
+    s.t_s = t;
+    const double dt = t - r.last_t_s;
+    if (r.valid && dt > 0.0) {
+      // Differences of the setpoints: the backward difference is the velocity half a period
+      // back; the change of it over the period, the acceleration.
+      const math::Vec3 v_back = (s.pose.p - before.pose.p) * (1.0 / dt);
+      s.acceleration_m_per_s2 = (v_back - r.velocity_back) * (1.0 / dt);
+      s.velocity_m_per_s = v_back + s.acceleration_m_per_s2 * (dt / 2.0);
+      r.velocity_back = v_back;
+      math::Vec3 axis;
+      double angle = 0.0;
+      (s.pose.R * before.pose.R.transposed()).to_axis_angle(axis, angle);
+      s.angular_velocity_rad_s = axis * (angle / dt);
+    }
+    r.published.store(s);
+    r.last_t_s = t;
+    world_->set_configuration(i, q);
+    r.braking_m = braking_m(model_.robots[i].model, g.previous_setpoint(), q,
+                            g.options().max_acceleration, r.period_s, r.lever_m);
+    r.valid = true;
+  }
+  if (options_.collision_checks) check_collisions();
+  if (observer_) observer_(tick);
+}
+
+void Cell::check_collisions() noexcept {
+  const std::size_t n = robots_.size();
+  const std::size_t found = world_->contacts(contacts_);
+  // A pair not reported is farther than the world's margin: as good as infinitely far.
+  std::vector<double>& last = last_distance_m_;
+  std::fill(seen_.begin(), seen_.end(), std::uint8_t{0});
+  for (std::size_t k = 0; k < std::min(found, contacts_.size()); ++k) {
+    const Contact& c = contacts_[k];
+    Robot& a = *robots_[c.robot_a];
+    Robot& b = *robots_[c.robot_b];
+    const std::size_t pair = c.robot_a * n + c.robot_b;
+    seen_[pair] = 1;
+    const double before = last[pair];
+    last[pair] = c.distance_m;
+    if (!a.valid || !b.valid) continue;
+    const double limit = model_.collision_margin_m + a.braking_m + b.braking_m;
+    // Only while they approach: two arms stopped close together may still move apart.
+    if (!(c.distance_m < limit) || !(c.distance_m < before)) continue;
+    try {
+      const auto r = fmt::format_to_n(
+          message_.data(), message_.size() - 1,
+          "collision stop: {} link {} and {} link {} would come {:.3f} m apart (margin {:.3f} m "
+          "+ braking {:.3f} m)",
+          a.name, c.link_a + 1, b.name, c.link_b + 1, c.distance_m, model_.collision_margin_m,
+          a.braking_m + b.braking_m);
+      *r.out = '\0';
+    } catch (...) {  // fmt allocates nothing here; the stop matters more than its words
+      message_[0] = '\0';
+    }
+    const std::string_view why(message_.data());
+    a.manipulator->generator().request_stop(why);
+    b.manipulator->generator().request_stop(why);
+    collision_stops_.fetch_add(1, std::memory_order_acq_rel);
+  }
+  for (std::size_t pair = 0; pair < n * n; ++pair) {
+    if (seen_[pair] == 0) last[pair] = kInf;
+  }
+}
+
+}  // namespace rccx::cell

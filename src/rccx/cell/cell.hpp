@@ -1,0 +1,182 @@
+// The workcell at run time (thesis 5.2, Multi-RCCL): several robots driven from one program on
+// one clock. A Cell builds, from a CellModel, each robot's simulated hardware and driver, one
+// rtc::SessionGroup at the cell's base period (each robot every period_multiple-th tick) and
+// one rccl::Manipulator per robot, the same motion API as a one-robot program:
+//
+//   cell::Cell cell(cell::load_cell_file("cells/cvarl.json"));
+//   cell.start();                                    // the group's tasks, every generator
+//   rccl::Manipulator& puma = cell.robot("puma");
+//   puma.move(p);  cell.robot("microbo").move(q);    // both move at once
+//   cell.wait_for(2s);                               // simulated time, for the whole cell
+//
+// Frames across robots: a robot's tool frame in the world, as the control task commands it,
+// is a functional transform another robot's equation may use (tool_frame, in_base_of):
+//
+//   T6 TOOL = BASE_INV(microbo) PUMA_TOOL GRASP      the Microbo follows what the PUMA holds
+//
+// The control task publishes every robot's commanded T6 TOOL (in the world, with its linear
+// velocity and acceleration and its angular velocity) after each tick through a seqlock; a
+// reader extrapolates it to the time its own setpoint is for (up to its pipeline of two
+// periods ahead), so a follower sampled at another rate does not lag.
+//
+// Safety between arms: after every tick the control task puts every robot's next setpoint
+// into a CollisionWorld (capsules per link, the cell's margin) and, when two robots' capsules
+// come closer than the margin plus both robots' braking allowance while approaching, asks both
+// generators to stop smoothly (TrajectoryGenerator::request_stop): their motions fail with a
+// message naming both robots and links (Manipulator::failures()). The braking allowance is a
+// bound on how far any point of a robot's links travels while it stops, see braking_m below.
+//
+// A robot's fault ends its own control only: the others go on.
+#pragma once
+
+#include <array>
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "rccx/cell/cell_model.hpp"
+#include "rccx/cell/collision.hpp"
+#include "rccx/cell/seqlock.hpp"
+#include "rccx/rccl/manipulator.hpp"
+#include "rccx/rccl/transforms.hpp"
+#include "rccx/rtc/session.hpp"
+#include "rccx/rtc/simulated_robot.hpp"
+
+namespace rccx::cell {
+
+struct CellOptions {
+  rtc::ClockKind clock = rtc::ClockKind::simulated;
+  /// Real time only: SCHED_FIFO and mlockall when allowed.
+  bool real_time_scheduling = true;
+  /// Stop two arms before their capsules come within the cell's margin.
+  bool collision_checks = true;
+};
+
+/// A robot's commanded tool frame in the world at one instant, as the control task publishes it.
+struct ToolSample {
+  math::Transform pose;               ///< world <- T6 TOOL, m
+  math::Vec3 velocity_m_per_s;        ///< of pose.p
+  math::Vec3 acceleration_m_per_s2;   ///< of pose.p
+  math::Vec3 angular_velocity_rad_s;  ///< of pose.R, world frame
+  double t_s = 0.0;                   ///< the time the setpoint is for, s
+};
+
+class Cell {
+ public:
+  /// Builds every robot (simulated hardware, driver, session of the group, manipulator).
+  /// Throws CellFileError for an invalid model, std::invalid_argument for a robot that cannot
+  /// be simulated, rtc::SessionError for a period a driver cannot serve.
+  explicit Cell(CellModel model, CellOptions options = {});
+  static std::unique_ptr<Cell> load(const std::filesystem::path& path, CellOptions options = {});
+  /// Stops every robot's control, then the group's tasks.
+  ~Cell();
+  Cell(const Cell&) = delete;
+  Cell& operator=(const Cell&) = delete;
+
+  /// Starts the group's tasks and every robot's trajectory generator (rccl_control).
+  void start();
+  /// Lets `d` pass for the whole cell (simulated time: runs those ticks).
+  void wait_for(std::chrono::nanoseconds d);
+
+  /// A robot's motion API. Throws std::invalid_argument naming the cell's robots for an
+  /// unknown name.
+  [[nodiscard]] rccl::Manipulator& robot(std::string_view name);
+  [[nodiscard]] rtc::Session& session(std::string_view name);
+  /// The simulated hardware below a robot's driver (a servo arm, or the Microbo's RCU), for
+  /// tests that push or fault it between samples of simulated time.
+  [[nodiscard]] rtc::SimulatedHardware& hardware(std::string_view name);
+  [[nodiscard]] std::vector<std::string> robot_names() const;
+  /// The index of a robot in the model (the order of the cell file); throws like robot().
+  [[nodiscard]] std::size_t index(std::string_view name) const;
+  [[nodiscard]] const CellModel& model() const noexcept { return model_; }
+  [[nodiscard]] rtc::SessionGroup& group() noexcept { return *group_; }
+
+  // --- Frames across robots ------------------------------------------------------------------
+  /// world <- the robot's base frame, m.
+  [[nodiscard]] const math::Transform& base(std::string_view name) const;
+  /// A pose given in the world expressed in the robot's base frame: base^-1 world_pose.
+  [[nodiscard]] math::Transform world_to_base(std::string_view name,
+                                              const math::Transform& world_pose) const;
+  /// A functional transform: `leader`'s commanded T6 TOOL in the world (its cell tool, or T6
+  /// without one), extrapolated to the sample's time. Before its first setpoint: its ready pose.
+  [[nodiscard]] rccl::TransformPtr tool_frame(std::string_view leader) const;
+  /// A world-frame transform in `robot`'s base frame (base^-1 T): constant for a constant T,
+  /// functional for a functional one. Throws std::invalid_argument for hold and T6.
+  [[nodiscard]] rccl::TransformPtr in_base_of(std::string_view robot,
+                                              const rccl::TransformPtr& world_transform) const;
+  /// The last published tool frame of a robot (any thread).
+  [[nodiscard]] ToolSample tool_sample(std::string_view name) const;
+
+  // --- Sample loop -----------------------------------------------------------------------------
+  /// A function the control task runs after each tick's collision check (tests, monitors).
+  /// Before start() only; it must not block. Inside it, collision_world() holds every robot's
+  /// next setpoint, and each generator's last_setpoint() may be read.
+  void set_cycle_observer(std::function<void(std::uint32_t tick)> observer);
+  /// The control task's collision world: read it from the cycle observer only.
+  [[nodiscard]] const CollisionWorld& collision_world() const noexcept { return *world_; }
+  /// How many times the check has stopped a pair of robots (any thread).
+  [[nodiscard]] std::uint64_t collision_stops() const noexcept {
+    return collision_stops_.load(std::memory_order_acquire);
+  }
+
+  /// A bound on how far any point of a robot's links (and capsules) travels from setpoint q1
+  /// (with q0 the setpoint one period P before) until it stands, when asked to stop now: the
+  /// generator's halt decelerates every joint at its bound a_j within one common time. The check
+  /// passes q1 only when the pair stays apart by this much, so that the stop may still begin
+  /// one setpoint later, from q2: with v_j = |q1_j - q0_j| / P + a_j P (q2's speed at most)
+  /// and Ts = max v_j / a_j, joint j travels at most v_j P to q2 and v_j Ts / 2 while it stops,
+  /// and a point moves at most lever_m[j] per rad of it (1 m per m of a prismatic joint), m.
+  static double braking_m(const kin::RobotModel& model, const kin::JointVector& q0,
+                          const kin::JointVector& q1, const kin::JointVector& max_acceleration,
+                          double period_s, const kin::JointVector& lever_m) noexcept;
+  /// How far a point of the links joint j moves (or of their capsules) can be from its axis:
+  /// the lengths of links j.. (|a| + |d|, a prismatic d at its farther end), the tool's offset
+  /// and the largest capsule radius, m.
+  static kin::JointVector levers_m(const CellRobot& robot);
+
+ private:
+  struct Robot {
+    std::string name;
+    rtc::SimulatedHardware hardware;
+    rtc::Session* session = nullptr;
+    std::unique_ptr<rccl::Manipulator> manipulator;
+    math::Transform base_inverse;
+    math::Transform tool;  ///< T6 <- tool (identity without one)
+    double period_s = 0.0;
+    kin::JointVector lever_m;  ///< levers_m()
+    SeqLock<ToolSample> published;
+    // Control task only.
+    double last_t_s = -1.0;  ///< the setpoint time last published
+    bool valid = false;      ///< has a setpoint in the collision world
+    double braking_m = 0.0;
+    math::Vec3 velocity_back;  ///< the tool point's last backward difference, m/s
+  };
+
+  [[nodiscard]] const Robot& find(std::string_view name) const;
+  [[nodiscard]] Robot& find(std::string_view name);
+  void on_cycle(std::uint32_t tick) noexcept;
+  void check_collisions() noexcept;
+
+  CellModel model_;
+  CellOptions options_;
+  // Declared before the group: the cycle hook uses them until the group's tasks stop.
+  std::vector<std::unique_ptr<Robot>> robots_;
+  std::unique_ptr<CollisionWorld> world_;
+  std::vector<Contact> contacts_;        ///< the check's buffer, one per robot pair
+  std::vector<double> last_distance_m_;  ///< per robot pair (a * n + b), the last tick's
+  std::vector<std::uint8_t> seen_;       ///< per robot pair: reported this tick
+  std::array<char, rccl::kEventText> message_{};
+  std::function<void(std::uint32_t)> observer_;
+  std::atomic<std::uint64_t> collision_stops_{0};
+  /// Last: its tasks (and the cycle hook) stop first, see ~Cell.
+  std::unique_ptr<rtc::SessionGroup> group_;
+  bool started_ = false;
+};
+
+}  // namespace rccx::cell

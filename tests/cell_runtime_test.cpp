@@ -1,0 +1,265 @@
+// The workcell at run time (cell::Cell) on cells/cvarl.json in simulated time: both robots
+// moving at once through the same motion API as one robot, the Microbo following a frame the
+// PUMA moves, two arms driven towards each other stopped before their capsules come within the
+// margin, and one robot's fault leaving the other working.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "rccx/cell/cell.hpp"
+#include "rccx/hw/simulated_arm.hpp"
+#include "rccx/math/units.hpp"
+
+using namespace rccx;
+using namespace std::chrono_literals;
+using namespace rccx::math::literals;
+
+namespace {
+
+const char* const kCvarl = RCCX_CVARL_CELL;
+
+/// Tool pointing down (a = -z of the world) at world point p.
+math::Transform down_at(const math::Vec3& p) {
+  return {math::Rot3::rot_x(math::kPi), p};
+}
+
+/// The equation T6 TOOL = BASE_INV(robot) WORLD_GOAL for a world pose.
+rccl::PositionPtr world_position(cell::Cell& c, const std::string& robot, const std::string& name,
+                                 const math::Transform& world_goal) {
+  const auto t6 = rccl::t6();
+  const auto tool = rccl::constant(robot + "_tool", c.model().find_robot(robot)->tool.value());
+  const auto goal = c.in_base_of(robot, rccl::constant(name, world_goal));
+  return rccl::Position::make(name, {t6, tool}, {goal}, tool);
+}
+
+/// A robot's tool point in the world for joints q.
+math::Vec3 tool_point(cell::Cell& c, const std::string& robot, const kin::JointVector& q) {
+  const cell::CellRobot& r = *c.model().find_robot(robot);
+  return (r.base * c.robot(robot).kinematics().forward(q) * r.tool.value()).p;
+}
+
+/// Where the board is: 50 mm above its top face.
+const math::Vec3 kAbove{0.0, 0.0, 0.1516};
+
+/// Every failure message of a robot, for assertion output.
+std::string failures_of(rccl::Manipulator& m) {
+  std::string s;
+  for (const rccl::MotionEvent& e : m.failures()) s += std::string(e.message()) + "; ";
+  return s;
+}
+
+}  // namespace
+
+TEST(CellRuntime, BuildsEveryRobotOfTheCellFile) {
+  const auto c = cell::Cell::load(kCvarl);
+  EXPECT_EQ(c->robot_names(), (std::vector<std::string>{"puma", "microbo"}));
+  EXPECT_EQ(c->session("puma").period(), 7ms);
+  EXPECT_EQ(c->session("microbo").period(), 28ms);
+  EXPECT_NE(c->hardware("puma").arm, nullptr);
+  EXPECT_NE(c->hardware("microbo").rcu, nullptr);
+  const math::Transform w = down_at(kAbove);
+  EXPECT_LT(math::max_abs_difference(c->base("microbo") * c->world_to_base("microbo", w), w),
+            1e-12);
+  try {
+    (void)c->robot("scara");
+    FAIL() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("puma, microbo"), std::string::npos) << e.what();
+  }
+}
+
+TEST(CellRuntime, BothRobotsMoveAtOnceInJointAndCartesianMode) {
+  const auto c = cell::Cell::load(kCvarl);
+  double closest_m = 1e9;
+  c->set_cycle_observer([&](std::uint32_t) {
+    closest_m = std::min(closest_m, c->collision_world().min_distance(0, 1).distance_m);
+  });
+  c->start();
+  rccl::Manipulator& puma = c->robot("puma");
+  rccl::Manipulator& microbo = c->robot("microbo");
+  const math::Vec3 p1 = kAbove + math::Vec3{-0.05, 0.0, 0.0};
+  const math::Vec3 m1 = kAbove + math::Vec3{0.10, 0.0, 0.0};
+  puma.set_velocity(0.05, 0.5);
+  microbo.set_velocity(0.05, 0.5);
+  const rccl::Motion a = puma.move(world_position(*c, "puma", "P1", down_at(p1)));
+  const rccl::Motion b = microbo.move(world_position(*c, "microbo", "M1", down_at(m1)));
+  c->wait_for(100ms);
+  EXPECT_TRUE(puma.happened(a.start()) && !puma.happened(a.end()));
+  EXPECT_TRUE(microbo.happened(b.start()) && !microbo.happened(b.end()));
+  ASSERT_EQ(puma.waitfor(a.end(), 20s), rccl::WaitResult::reached) << failures_of(puma);
+  ASSERT_EQ(microbo.waitfor(b.end(), 20s), rccl::WaitResult::reached) << failures_of(microbo);
+
+  // Cartesian: both 30 mm along y, at once.
+  puma.set_mode(rccl::Mode::cartesian);
+  microbo.set_mode(rccl::Mode::cartesian);
+  puma.set_velocity(0.05, 1.0);
+  microbo.set_velocity(0.05, 1.0);
+  const math::Vec3 dy{0.0, 0.03, 0.0};
+  const rccl::Motion a2 = puma.move(world_position(*c, "puma", "P2", down_at(p1 + dy)));
+  const rccl::Motion b2 = microbo.move(world_position(*c, "microbo", "M2", down_at(m1 + dy)));
+  ASSERT_EQ(puma.waitfor(a2.end(), 20s), rccl::WaitResult::reached) << failures_of(puma);
+  ASSERT_EQ(microbo.waitfor(b2.end(), 20s), rccl::WaitResult::reached) << failures_of(microbo);
+  c->wait_for(1s);  // the arms settle
+  EXPECT_LT((tool_point(*c, "puma", c->session("puma").how().q()) - (p1 + dy)).norm(), 2e-3);
+  EXPECT_LT((tool_point(*c, "microbo", c->session("microbo").how().q()) - (m1 + dy)).norm(), 2e-3);
+  EXPECT_LT(puma.report(a2).max_commanded_path_error_m, 1e-4);
+  EXPECT_LT(microbo.report(b2).max_commanded_path_error_m, 1e-4);
+  EXPECT_TRUE(puma.failures().empty());
+  EXPECT_TRUE(microbo.failures().empty());
+  EXPECT_EQ(c->collision_stops(), 0U);
+  EXPECT_GE(closest_m, c->model().collision_margin_m);
+}
+
+TEST(CellRuntime, TheMicroboFollowsAFrameThePumaMoves) {
+  const auto c = cell::Cell::load(kCvarl);
+  // Every new setpoint of each robot (the control task's), kept for the comparison after.
+  struct Sample {
+    double t_s;
+    math::Vec3 p;
+  };
+  std::vector<Sample> leader, follower;
+  leader.reserve(20000);
+  follower.reserve(20000);
+  double leader_t = -1.0, follower_t = -1.0;
+  c->set_cycle_observer([&](std::uint32_t) {
+    const rccl::TrajectoryGenerator& gp = c->robot("puma").generator();
+    const rccl::TrajectoryGenerator& gm = c->robot("microbo").generator();
+    if (gp.last_setpoint().size() == 6 && gp.last_setpoint_time_s() != leader_t &&
+        leader.size() < leader.capacity()) {
+      leader_t = gp.last_setpoint_time_s();
+      leader.push_back({leader_t, tool_point(*c, "puma", gp.last_setpoint())});
+    }
+    if (gm.last_setpoint().size() == 6 && gm.last_setpoint_time_s() != follower_t &&
+        follower.size() < follower.capacity()) {
+      follower_t = gm.last_setpoint_time_s();
+      follower.push_back({follower_t, tool_point(*c, "microbo", gm.last_setpoint())});
+    }
+  });
+  c->start();
+  rccl::Manipulator& puma = c->robot("puma");
+  rccl::Manipulator& microbo = c->robot("microbo");
+
+  // GRASP: the Microbo's tool 150 mm along the PUMA's tool x (the world's x: both point down).
+  const math::Transform grasp_offset = math::Transform::translation(0.15, 0.0, 0.0);
+  const math::Vec3 p0 = kAbove + math::Vec3{-0.05, 0.0, 0.0};
+  puma.set_velocity(0.05, 0.5);  // joint moves slow enough near the other arm
+  microbo.set_velocity(0.05, 0.5);
+  puma.move(world_position(*c, "puma", "P0", down_at(p0)));
+  microbo.move(world_position(*c, "microbo", "M0", down_at(p0) * grasp_offset));
+  ASSERT_EQ(puma.waitfor(rccl::Manipulator::completed(), 20s), rccl::WaitResult::reached)
+      << failures_of(puma);
+  ASSERT_EQ(microbo.waitfor(rccl::Manipulator::completed(), 20s), rccl::WaitResult::reached)
+      << failures_of(microbo);
+
+  // T6 TOOL = BASE_INV(microbo) PUMA_TOOL GRASP_OFFSET
+  const auto t6 = rccl::t6();
+  const auto tool = rccl::constant("TOOL", c->model().find_robot("microbo")->tool.value());
+  const auto puma_tool = c->in_base_of("microbo", c->tool_frame("puma"));
+  const auto grasp = rccl::constant("GRASP_OFFSET", grasp_offset);
+  const auto follow = rccl::Position::make("FOLLOW", {t6, tool}, {puma_tool, grasp}, tool);
+  microbo.set_mode(rccl::Mode::cartesian);
+  const rccl::Motion f = microbo.move(follow);
+  ASSERT_EQ(microbo.waitfor(f.end(), 20s), rccl::WaitResult::reached) << failures_of(microbo);
+
+  // The PUMA carries the board 30 mm one way along y, then the other, then back.
+  const std::size_t from = follower.size();
+  const double following_from_s = follower.back().t_s;
+  puma.set_mode(rccl::Mode::cartesian);
+  puma.set_velocity(0.02, 0.5);
+  puma.move(world_position(*c, "puma", "PY1", down_at(p0 + math::Vec3{0.0, 0.03, 0.0})));
+  puma.move(world_position(*c, "puma", "PY2", down_at(p0 + math::Vec3{0.0, -0.03, 0.0})));
+  puma.move(world_position(*c, "puma", "PY3", down_at(p0)));
+  ASSERT_EQ(puma.waitfor(rccl::Manipulator::completed(), 60s), rccl::WaitResult::reached)
+      << failures_of(puma);
+  c->wait_for(500ms);
+  EXPECT_TRUE(puma.failures().empty());
+  EXPECT_TRUE(microbo.failures().empty()) << microbo.failures().front().message();
+  EXPECT_TRUE(c->session("microbo").controlling());
+
+  // Each follower setpoint against the leader's tool at the same instant (interpolated
+  // between its setpoints), through the grasp offset.
+  double worst_m = 0.0, travel_m = 0.0;
+  std::size_t compared = 0;
+  for (std::size_t i = from; i < follower.size(); ++i) {
+    const double t = follower[i].t_s;
+    if (t <= following_from_s) continue;
+    const auto it = std::lower_bound(leader.begin(), leader.end(), t,
+                                     [](const Sample& s, double x) { return s.t_s < x; });
+    if (it == leader.begin() || it == leader.end()) continue;
+    const Sample& b = *it;
+    const Sample& a = *(it - 1);
+    const double u = (t - a.t_s) / (b.t_s - a.t_s);
+    const math::Vec3 lp = a.p + (b.p - a.p) * u;
+    worst_m = std::max(worst_m, (follower[i].p - (lp + math::Vec3{0.15, 0.0, 0.0})).norm());
+    travel_m = std::max(travel_m, std::abs(follower[i].p.y));
+    ++compared;
+  }
+  RecordProperty("worst_mm", std::to_string(worst_m * 1e3));
+  EXPECT_GT(compared, 100U);
+  EXPECT_GT(travel_m, 0.029) << "the follower did not move with the leader";
+  EXPECT_LT(worst_m, 1e-3) << "commanded tool points apart by up to " << worst_m * 1e3 << " mm";
+}
+
+TEST(CellRuntime, TwoArmsDrivenTowardsEachOtherStopOutsideTheMargin) {
+  const auto c = cell::Cell::load(kCvarl);
+  const double margin_m = c->model().collision_margin_m;
+  double closest_m = 1e9;
+  c->set_cycle_observer([&](std::uint32_t) {
+    closest_m = std::min(closest_m, c->collision_world().min_distance(0, 1).distance_m);
+  });
+  c->start();
+  rccl::Manipulator& puma = c->robot("puma");
+  rccl::Manipulator& microbo = c->robot("microbo");
+  // Each to the other's side of the board: their tools would cross.
+  const rccl::Motion a =
+      puma.move(world_position(*c, "puma", "PX", down_at(kAbove + math::Vec3{0.04, 0, 0})));
+  const rccl::Motion b =
+      microbo.move(world_position(*c, "microbo", "MX", down_at(kAbove + math::Vec3{-0.04, 0, 0})));
+  EXPECT_EQ(puma.waitfor(a.end(), 20s), rccl::WaitResult::failed) << failures_of(puma);
+  EXPECT_EQ(microbo.waitfor(b.end(), 20s), rccl::WaitResult::failed) << failures_of(microbo);
+  c->wait_for(1s);  // both stand
+  EXPECT_GE(c->collision_stops(), 1U);
+  EXPECT_GE(closest_m, margin_m) << "capsules came within the margin";
+  RecordProperty("closest_mm", std::to_string(closest_m * 1e3));
+  for (rccl::Manipulator* m : {&puma, &microbo}) {
+    ASSERT_FALSE(m->failures().empty());
+    const std::string msg(m->failures().front().message());
+    EXPECT_NE(msg.find("puma link "), std::string::npos) << msg;
+    EXPECT_NE(msg.find("microbo link "), std::string::npos) << msg;
+    EXPECT_TRUE(m->session().controlling()) << "a collision stop is a failed motion, not an end";
+  }
+  // Stopped, they may move apart again.
+  const rccl::Motion back = microbo.move(microbo.park());
+  EXPECT_EQ(microbo.waitfor(back.end(), 20s), rccl::WaitResult::reached) << failures_of(microbo);
+}
+
+TEST(CellRuntime, OneRobotsFaultLeavesTheOtherWorking) {
+  const auto c = cell::Cell::load(kCvarl);
+  c->start();
+  rccl::Manipulator& puma = c->robot("puma");
+  rccl::Manipulator& microbo = c->robot("microbo");
+  const math::Vec3 p1 = kAbove + math::Vec3{-0.05, 0.0, 0.0};
+  const math::Vec3 m1 = kAbove + math::Vec3{0.10, 0.0, 0.0};
+  puma.set_velocity(0.05, 0.5);
+  microbo.set_velocity(0.05, 0.5);
+  const rccl::Motion a = puma.move(world_position(*c, "puma", "P1", down_at(p1)));
+  const rccl::Motion b = microbo.move(world_position(*c, "microbo", "M1", down_at(m1)));
+  c->wait_for(200ms);
+  c->hardware("puma").arm->inject(hw::Fault::joint_not_answering, 1);
+  EXPECT_EQ(puma.waitfor(a.end(), 5s), rccl::WaitResult::session_ended) << failures_of(puma);
+  EXPECT_EQ(c->session("puma").termination().code, rtc::TerminateCode::joint_not_answering);
+  ASSERT_EQ(microbo.waitfor(b.end(), 20s), rccl::WaitResult::reached) << failures_of(microbo);
+  EXPECT_TRUE(c->session("microbo").controlling());
+  c->wait_for(500ms);
+  EXPECT_LT((tool_point(*c, "microbo", c->session("microbo").how().q()) - m1).norm(), 2e-3);
+  // And it goes on moving.
+  microbo.set_mode(rccl::Mode::cartesian);
+  const rccl::Motion b2 =
+      microbo.move(world_position(*c, "microbo", "M2", down_at(m1 + math::Vec3{0.0, 0.03, 0.0})));
+  EXPECT_EQ(microbo.waitfor(b2.end(), 20s), rccl::WaitResult::reached) << failures_of(microbo);
+  EXPECT_TRUE(microbo.failures().empty());
+}
