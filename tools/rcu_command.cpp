@@ -83,7 +83,13 @@ int run_rcu(const RcuArgs& a) {
     io::StopAwareInput buffer(STDIN_FILENO);
     std::istream in(&buffer);
     std::string line;
-    while (io::stop_count() == stops && std::getline(in, line)) {
+    std::string too_long;  // a line refused by its length
+    while (io::stop_count() == stops && io::read_line(in, line, too_long)) {
+      if (!too_long.empty()) {
+        io::eprint("error: {}\n", too_long);
+        status = kFailure;
+        continue;
+      }
       if (!run_line(*rcu, line, stops)) status = kFailure;
     }
     if (buffer.error() != 0) {
