@@ -496,7 +496,8 @@ int run_jointtest(const RtcArgs& a) {
   };
   // Ctrl-C ends the program (the arm holds) rather than control: the loop sees the stop count.
   r.session->set_hangup_handler([](rtc::Session&) {});
-  const std::uint32_t stops = io::stop_count();
+  // main() installed the handlers at start: a signal during the start-up counts too.
+  const std::uint32_t stops = 0;
   const auto stopped = [stops] { return io::stop_count() != stops; };
   const auto start = [&] { r.session->control(f1, f2); };
   start();
@@ -539,7 +540,7 @@ int run_jointtest(const RtcArgs& a) {
 
   fmt::print("jointtest on {} ({} joints), {} time, period {:.3f} ms. ? for the menu.\n", m.title,
              m.dof(), r.simulated() ? "simulated" : "real", r.period_s() * 1e3);
-  io::StopAwareInput buffer(STDIN_FILENO);  // ends a wait for a line on Ctrl-C / SIGTERM
+  io::StopAwareInput buffer(STDIN_FILENO, stops);  // ends a wait for a line on Ctrl-C / SIGTERM
   std::istream input(&buffer);
   std::string line;
   std::string too_long;  // a line refused by its length

@@ -52,7 +52,9 @@ int run_teach(const TeachArgs& a) {
     rccl::PositionDb db(file);
     rccl::Manipulator arm(*robot.session);
     arm.start();
-    io::StopAwareInput input(STDIN_FILENO);  // Ctrl-C ends a wait for a line
+    // Ctrl-C ends a wait for a line; also one during the start-up (main() installed the
+    // handlers at start).
+    io::StopAwareInput input(STDIN_FILENO, 0);
     std::istream in(&input);
     const rccl::Taught t = rccl::teach_loop(
         arm, {in, std::cout, &db, [&](std::size_t j, double e) { robot.push(j, e); }});

@@ -12,6 +12,9 @@ namespace rccx::io {
 
 StopAwareInput::StopAwareInput(int fd) noexcept : fd_(fd), stops_at_start_(stop_count()) {}
 
+StopAwareInput::StopAwareInput(int fd, std::uint32_t stops_before) noexcept
+    : fd_(fd), stops_at_start_(stops_before) {}
+
 StopAwareInput::int_type StopAwareInput::underflow() {
   if (gptr() < egptr()) return traits_type::to_int_type(*gptr());
   for (;;) {

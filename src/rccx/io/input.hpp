@@ -21,6 +21,9 @@ class StopAwareInput : public std::streambuf {
  public:
   /// Reads `fd`; stops at the first stop signal after construction.
   explicit StopAwareInput(int fd) noexcept;
+  /// Reads `fd`; stops once more than `stops_before` stop signals have arrived. A program that
+  /// installed the handlers at its start gives 0: a signal during its start-up counts.
+  StopAwareInput(int fd, std::uint32_t stops_before) noexcept;
   /// True when reading ended because of SIGINT / SIGTERM.
   [[nodiscard]] bool stopped() const noexcept { return stopped_; }
   /// True when reading ended because of a read error (not end of input).
