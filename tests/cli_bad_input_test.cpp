@@ -3,6 +3,7 @@
 // with the exit code and the words of the message it must get, and what it must not leave.
 #include <fmt/format.h>
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -44,6 +45,7 @@ class BadInput : public ::testing::Test {
     write("latin1.json", std::string(R"({"name": "caf)") + "\xe9" + R"(", "title": "t"})");
     write("not_json.json", "name = puma\n");
     write("empty.json", "");
+    ::mkfifo(path("fifo.json").c_str(), 0600);
   }
   void TearDown() override { fs::remove_all(dir_); }
 
@@ -70,8 +72,9 @@ class BadInput : public ::testing::Test {
       for (std::size_t at; (at = env.find("DIR/")) != std::string::npos;) {
         env.replace(at, 4, dir_.string() + "/");
       }
-      const std::string command =
-          (env.empty() ? "" : "env " + env + " ") + std::string(RCCX_CLI) + " " + args;
+      // timeout: a command that hangs fails its row (exit 124) rather than the whole run.
+      const std::string command = "timeout -k 5 60 " + (env.empty() ? "" : "env " + env + " ") +
+                                  std::string(RCCX_CLI) + " " + args;
       const CommandRun r = run(command);
       EXPECT_EQ(r.exit_code, row.exit_code) << command << "\n" << r.out;
       EXPECT_NE(r.out.find(row.says), std::string::npos)
@@ -106,6 +109,9 @@ TEST_F(BadInput, Kinematics) {
       {"", "kin fk --robot-file DIR/empty.json 0", 2, "not valid JSON", ""},
       {"", "kin fk --robot-file DIR/ 0", 2, "directory", ""},
       {"", "kin fk --robot-file DIR/missing.json 0", 2, "does not exist", ""},
+      // A named pipe nobody writes to and an endless device: refused at once, no wait.
+      {"", "kin fk --robot-file DIR/fifo.json 0", 2, "not a regular file", ""},
+      {"", "kin fk --robot-file /dev/zero 0", 2, "not a regular file", ""},
       {"", "kin ik --robot puma560 --T 1,0,0,0.4,0,1,0,0,0,0,1", 2, "11 numbers given, 12 needed",
        ""},
       {"", "kin ik --robot puma560 --T 1,0,0,0.4,0,1,0,0,0,0,1,0,1", 2, "13 numbers given", ""},
@@ -150,6 +156,17 @@ TEST_F(BadInput, ControlPrograms) {
       {"", "report --log DIR/ --seconds 0.1", 2, "directory", ""},
       {"RCCX_LOG=DIR/missing/x.csv", "report --seconds 0.1", 2, "RCCX_LOG", "missing"},
       {"", "report extra", 2, "extra", ""},
+      // An empty value is a variable that was not set, not the default.
+      {"", "report --period '' --seconds 0.1", 2, "--period: \"\" is empty", ""},
+      {"", "report --log '' --seconds 0.1", 2, "--log: \"\" is empty", ""},
+      {"", "jointtest --log '' < /dev/null", 2, "--log: \"\" is empty", ""},
+      {"", "teach --db '' < /dev/null", 2, "--db: \"\" is empty", ""},
+      {"", "teach --db DIR/ < /dev/null", 2, "is a directory; name a database file", ""},
+      {"RCCX_DB=/dev/null", "teach < /dev/null", 2, "not a regular file", ""},
+      // A bad robot creates no database.
+      {"", "teach --robot nosuch --db DIR/t.db < /dev/null", 2, "known robots", "t.db"},
+      {"", "teach --robot-file DIR/empty.json --db DIR/t.db < /dev/null", 2, "not valid JSON",
+       "t.db"},
       {"", "calib --timeout inf", 2, "--timeout", ""},
       {"", "calib --timeout 0", 2, "--timeout", ""},
       {"", "marsh --push 3:1e400", 2, "too large", ""},
@@ -163,6 +180,25 @@ TEST_F(BadInput, ControlPrograms) {
       {"", "report --seconds 0.2 --every 0.1", 0, "theta", ""},
       {"", "calib --robot puma560 --uncalibrated --timeout 60", 0, "ALL JOINTS", ""},
   });
+}
+
+// A log is written through a symbolic link (the link stays) and into a named pipe (never
+// replaced by a regular file: `--log /dev/null` as root must not replace /dev/null).
+TEST_F(BadInput, ALogThroughALinkOrIntoAPipeLeavesItWhatItIs) {
+  fs::create_symlink("target.csv", dir_ / "link.csv");
+  const std::string rccx = "timeout -k 5 60 " + std::string(RCCX_CLI);
+  const CommandRun linked = run(rccx + " report --seconds 0.1 --log " + path("link.csv"));
+  EXPECT_EQ(linked.exit_code, 0) << linked.out;
+  EXPECT_TRUE(fs::is_symlink(dir_ / "link.csv"));
+  EXPECT_NE(std::ifstream(dir_ / "target.csv").peek(), EOF) << "the log is not where the link goes";
+  const CommandRun piped = run(rccx + " report --seconds 0.1 --log " + path("fifo.json"));
+  EXPECT_EQ(piped.exit_code, 2) << piped.out;
+  EXPECT_NE(piped.out.find("no process reads"), std::string::npos) << piped.out;
+  EXPECT_TRUE(fs::is_fifo(dir_ / "fifo.json")) << "the pipe was replaced by a regular file";
+  const CommandRun out = run(rccx + " report --seconds 0.1 --log /dev/stdout");
+  EXPECT_EQ(out.exit_code, 0) << out.out;
+  EXPECT_NE(out.out.find("t,seg,q1"), std::string::npos) << out.out;
+  EXPECT_TRUE(fs::is_character_file("/dev/stdout") || fs::is_fifo("/dev/stdout"));
 }
 
 }  // namespace

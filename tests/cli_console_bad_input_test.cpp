@@ -118,6 +118,11 @@ TEST(CliConsole, TeachRefusesBadLinesMovesNothingAndExits1) {
        {"the arm holds", "hand open"}},
       // Everything done: 0.
       {"teach --robot puma560", "m 1 10\nxd\ne\n", 0, {"joints 9.9"}, {"error"}},
+      {"teach --robot puma560",
+       "m 1 10" + std::string(5000, ' ') + "5\nxd\ne\n",
+       1,
+       {"refused whole", "joints 0.0"},
+       {}},
   };
   for (const Case& c : cases) {
     const TempFile db;
@@ -152,6 +157,10 @@ TEST(CliConsole, JointtestRefusesBadLinesAndExits1) {
       {"jointtest", "k 300\nk 40.5\nq\n", 1, {"from 0 to 255", "not a whole number"}, {"dynamic"}},
       {"jointtest --robot puma560", "q now\nq\n", 1, {"one word too many"}, {}},
       {"jointtest --robot puma560", "j 2\nm 10\nw 2\nq\n", 0, {"joint 2 (theta2)"}, {}},
+      // A line too long for a command is refused whole; endless input ends the console.
+      {"jointtest", std::string(5000, 'x') + "\nx\nq\n", 1, {"refused whole", "theta1"}, {}},
+      // M while an m move is under way: the ramp starts where the joint is, not too fast.
+      {"jointtest", "m 10\nM 20\nw 1\nx\nq\n", 0, {"theta1      20.0"}, {"control ended"}},
   };
   for (const Case& c : cases) check(c, rccx_with_input(c.arguments, c.input));
 }
@@ -164,6 +173,8 @@ TEST(CliConsole, RcuRefusesBadLinesAndExits1) {
       {"rcu", "out 5805 04 05\n", 1, {"one word too many"}, {}},
       {"rcu", "fault 1.0 encoder_error\n", 1, {"the joint must be 1 to 6"}, {}},
       {"rcu", "in 5801\n# note\n\nstep 0.1\n", 0, {"00\n"}, {"error"}},
+      {"rcu", std::string(2u << 20, '\0') + "\nin 5801\n", 1, {"not lines of commands"}, {"00\n"}},
+      {"rcu", "in 5801\r\nin 5800", 0, {"00\n"}, {"error"}},  // CRLF, no last line end
   };
   for (const Case& c : cases) check(c, rccx_with_input(c.arguments, c.input));
 }

@@ -9,6 +9,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdio>
 #include <cstdlib>
@@ -35,7 +36,9 @@ using CliRun = rccx::test::ShellRun;  // stdout and stderr
 
 /// Runs `rccx ARGUMENTS` through bash (so `ARGUMENTS` may redirect and write bytes as $'\xff').
 CliRun rccx_cli(const std::string& arguments) {
-  const std::string command = "exec " + std::string(RCCX_CLI) + " 2>&1 " + arguments;
+  // timeout: a command that hangs fails its row (exit 124) rather than the whole run.
+  const std::string command =
+      "exec timeout -k 5 60 " + std::string(RCCX_CLI) + " 2>&1 " + arguments;
   ::setenv("RCCX_TEST_COMMAND", command.c_str(), 1);  // no quoting of the command itself
   const rccx::test::ShellRun r = rccx::test::run_shell("exec bash -c \"$RCCX_TEST_COMMAND\"");
   return r;
@@ -289,6 +292,17 @@ TEST_F(CliDbBadInput, ExportFailuresLeaveTheOldFileAndNoTemporary) {
   EXPECT_EQ(std::distance(fs::directory_iterator(dir_ / "ok"), fs::directory_iterator()), 1);
 }
 
+TEST_F(CliDbBadInput, AFullStandardOutputIsSaidOnce) {
+  const fs::path db = dir_ / "cell.db";
+  rccl::StoredTransform keep;
+  keep.robot = "microbo";
+  keep.name = "KEEP";
+  rccl::PositionDb(db).put(keep);
+  const CliRun run = rccx_cli("db --db " + db.string() + " export > /dev/full");
+  EXPECT_EQ(run.exit_code, 1) << run.out;
+  EXPECT_EQ(std::count(run.out.begin(), run.out.end(), '\n'), 1) << "one line:\n" << run.out;
+}
+
 TEST_F(CliDbBadInput, ImportIsStrictAndAllOrNothing) {
   const std::string imp = "db --db {db} import {dir}/in.json";
   const auto in = [](const std::string& text) { return with_file("in.json", text); };
@@ -296,6 +310,14 @@ TEST_F(CliDbBadInput, ImportIsStrictAndAllOrNothing) {
   run_all({
       {"db --db {db} import {dir}", 2, "is a directory; name a file"},
       {"db --db {db} import {dir}/missing.json", 2, "No such file"},
+      // A named pipe nobody writes: refused at once, not waited on for ever.
+      {"db --db {db} import {dir}/fifo", 2, "not a regular file",
+       [](const fs::path& dir, const fs::path&) {
+         fs::remove(dir / "fifo");
+         ::mkfifo((dir / "fifo").c_str(), 0600);
+         return std::shared_ptr<void>();
+       }},
+      {"db --db {db} import /dev/zero", 2, "not a regular file"},
       {"db --db {db} import ''", 2, "empty"},
       {imp, 2, "not JSON", in("")},
       {imp, 2, "not JSON", in("{\"rccx_position_database\": 1, ")},

@@ -1,4 +1,4 @@
-// SIGINT and SIGTERM at random moments in the rccx commands: each ends within a bound (no
+// SIGINT, SIGTERM and SIGHUP at random moments in the rccx commands: each ends within a bound (no
 // hang), with 128 + the signal as its exit code (never an abort), its log ending on a row
 // boundary, its database whole. Also: stderr closed, stdout a full pipe.
 #include <fcntl.h>
@@ -165,7 +165,8 @@ class Signals : public ::testing::Test {
 };
 
 TEST_F(Signals, ReportEndsOnSigintAndSigtermWithItsLogWhole) {
-  for (const int sig : {SIGINT, SIGTERM, SIGINT, SIGTERM}) {
+  // SIGHUP: the terminal went away (a closed ssh session); it too ends cleanly.
+  for (const int sig : {SIGINT, SIGTERM, SIGHUP, SIGINT, SIGTERM}) {
     const fs::path log = dir_ / "report.csv";
     fs::remove(log);
     Options o;
@@ -184,6 +185,10 @@ TEST_F(Signals, ReportEndsOnSigintAndSigtermWithItsLogWhole) {
     EXPECT_EQ(code, 128 + sig) << slurp(dir_ / "stderr");
     expect_whole_rows(log);
     EXPECT_TRUE(fs::is_empty(dir_ / "stderr") == false);
+    for (const auto& e : fs::directory_iterator(dir_)) {
+      EXPECT_EQ(e.path().filename().string().find(".tmp-"), std::string::npos)
+          << "a temporary file was left: " << e.path();
+    }
   }
 }
 

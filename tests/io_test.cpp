@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "rccx/io/file.hpp"
+#include "rccx/io/input.hpp"
 #include "rccx/io/parse.hpp"
 
 namespace rccx::io {
@@ -153,6 +154,70 @@ TEST_F(FileTest, ErrorsNameTheFileAndChangeNothing) {
         dir_, std::filesystem::perms::owner_read | std::filesystem::perms::owner_exec);
     EXPECT_THROW(write_file_atomically(dir_ / "f", "x"), FileError);
   }
+}
+
+TEST_F(FileTest, ASymbolicLinkIsFollowedAndStays) {
+  const auto target = dir_ / "target.csv";
+  const auto link = dir_ / "link.csv";
+  std::filesystem::create_symlink("target.csv", link);  // relative, and dangling at first
+  write_file_atomically(link, "first\n");
+  EXPECT_TRUE(std::filesystem::is_symlink(link));
+  EXPECT_EQ(slurp(target), "first\n");
+  write_file_atomically(link, "second\n");
+  EXPECT_TRUE(std::filesystem::is_symlink(link));
+  EXPECT_EQ(slurp(target), "second\n");
+  EXPECT_EQ(entries(), 2U);  // no temporary left
+}
+
+TEST_F(FileTest, ANamedPipeIsWrittenInPlaceNotReplaced) {
+  const auto fifo = dir_ / "pipe";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  // Nobody reads: refused at once rather than waited on, and the pipe stays a pipe.
+  try {
+    write_file_atomically(fifo, "x");
+    FAIL() << "written to a pipe nobody reads";
+  } catch (const FileError& e) {
+    EXPECT_NE(std::string(e.what()).find("no process reads"), std::string::npos) << e.what();
+  }
+  const int reader = ::open(fifo.c_str(), O_RDONLY | O_NONBLOCK);
+  ASSERT_GE(reader, 0);
+  write_file_atomically(fifo, "rows\n");
+  char got[16] = {};
+  EXPECT_EQ(::read(reader, got, sizeof got), 5);
+  EXPECT_STREQ(got, "rows\n");
+  ::close(reader);
+  struct stat st {};
+  ASSERT_EQ(::lstat(fifo.c_str(), &st), 0);
+  EXPECT_TRUE(S_ISFIFO(st.st_mode)) << "the pipe was replaced by a regular file";
+  EXPECT_EQ(entries(), 1U);
+}
+
+TEST_F(FileTest, ReadingANamedPipeOrADeviceIsRefusedAtOnce) {
+  const auto fifo = dir_ / "pipe";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  EXPECT_THROW((void)read_file(fifo), FileError);         // would wait for a writer for ever
+  EXPECT_THROW((void)read_file("/dev/zero"), FileError);  // would never end
+}
+
+TEST(ReadLine, LinesAreBoundedAndEndlessInputEnds) {
+  std::string line;
+  std::string problem;
+  std::istringstream in("m 10\r\n" + std::string(5000, 'x') + "\nq");
+  ASSERT_TRUE(read_line(in, line, problem));
+  EXPECT_EQ(line, "m 10\r");
+  EXPECT_EQ(problem, "");
+  ASSERT_TRUE(read_line(in, line, problem));  // refused whole, the next line read
+  EXPECT_EQ(line, "");
+  EXPECT_NE(problem.find("5000 bytes"), std::string::npos) << problem;
+  ASSERT_TRUE(read_line(in, line, problem));  // the last line, without its line end
+  EXPECT_EQ(line, "q");
+  EXPECT_EQ(problem, "");
+  EXPECT_FALSE(read_line(in, line, problem));
+
+  std::istringstream zeros(std::string(3u << 20, '\0'));  // /dev/zero, a binary file
+  ASSERT_TRUE(read_line(zeros, line, problem));
+  EXPECT_NE(problem.find("not lines of commands"), std::string::npos) << problem;
+  EXPECT_FALSE(read_line(zeros, line, problem));  // reading stopped, not 3 MiB held
 }
 
 TEST(WriteAll, ReportsTheFailureOfAFullDevice) {

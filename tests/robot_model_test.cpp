@@ -151,6 +151,15 @@ TEST(RobotFile, RefusesBadInputWithMessagesThatSayWhere) {
   expect_error(replaced(kGoodRobot, "\"ready_m\": 0.1", "\"ready_m\": 0.5"), "ready");
   expect_error(replaced(kGoodRobot, "\"a_m\": 0.5", "\"a_m\": \"x\""), "\"a_m\" must be a number");
   expect_error(replaced(kGoodRobot, "\"name\": \"two\", ", ""), "missing \"name\"");
+  // The JSON library would keep the last of a repeated key: a limit given twice is refused.
+  expect_error(replaced(kGoodRobot, "\"lower_deg\": -90", "\"lower_deg\": -90, \"lower_deg\": -80"),
+               "key \"lower_deg\" is given twice");
+  // Deep nesting is refused while parsing (dump() of it overflowed the stack).
+  const std::size_t deep = 100000;
+  expect_error(replaced(kGoodRobot, "\"solver\": \"dh\"",
+                        "\"solver\": \"dh\", \"hardware\": {\"rcu\": " + std::string(deep, '[') +
+                            std::string(deep, ']') + "}"),
+               "nested more than 32 deep");
 }
 
 TEST(RobotFile, RefusesAMissingOrBadMaxVelocity) {

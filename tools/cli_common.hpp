@@ -24,6 +24,17 @@ struct BadArgument {
   std::string message;
 };
 
+/// Refuses "" for an option: an empty value is a variable that was not set (`--log "$LOG"`), not
+/// a choice, and must not silently mean the default (no log, the default period, ./rccx.db).
+inline CLI::Validator not_empty() {
+  return CLI::Validator(
+      [](const std::string& value) {
+        return value.empty() ? std::string("\"\" is empty; give a value (see --help)")
+                             : std::string();
+      },
+      "", "NOT_EMPTY");
+}
+
 /// --robot / --robot-file.
 struct RobotChoice {
   std::string name;

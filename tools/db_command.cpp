@@ -1,6 +1,7 @@
 #include "db_command.hpp"
 
 #include <fcntl.h>
+#include <stdio_ext.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -83,6 +84,10 @@ void write_stdout(std::string_view text) {
   const std::size_t n = std::fwrite(text.data(), 1, text.size(), stdout);
   std::string why;
   if (!io::flush_stdout(why) || n != text.size()) {
+    // What is left in the buffer is lost all the same: dropped, so that the check of standard
+    // output at exit does not say it a second time.
+    __fpurge(stdout);
+    std::clearerr(stdout);
     throw io::FileError(
         fmt::format("cannot write to standard output: {}; the output is "
                     "incomplete (write to a file with room, or a working pipe)",

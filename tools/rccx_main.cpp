@@ -21,7 +21,8 @@ int run(int argc, char** argv) {
   CLI::App app{
       "rccx - robot programming and real-time control in the manner of RCCL/RTC (1986).\n"
       "Units are SI (m, rad, s) unless an option says otherwise. Exit codes: 0 done, 1 failed "
-      "while running, 2 bad input, 3 pose out of reach, 130 / 143 ended by SIGINT / SIGTERM.",
+      "while running, 2 bad input, 3 pose out of reach, 130 / 143 / 129 ended by SIGINT / "
+      "SIGTERM / SIGHUP.",
       "rccx"};
   app.set_version_flag("--version", "rccx 0.1.0");
   app.require_subcommand(1);
@@ -80,7 +81,8 @@ int main(int argc, char** argv) {
   }
   if (io::stop_count() > 0 && code != tools::kBadArguments) {
     code = io::stop_exit_code();
-    io::eprint("rccx: stopped by {}\n", code == 143 ? "SIGTERM" : "SIGINT");
+    io::eprint("rccx: stopped by {}\n",
+               code == 143 ? "SIGTERM" : (code == 129 ? "SIGHUP" : "SIGINT"));
   }
   return code;
 }

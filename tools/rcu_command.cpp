@@ -77,13 +77,21 @@ int run_rcu(const RcuArgs& a) {
   }
   // Ctrl-C and SIGTERM end the console between lines or within a step, not the process.
   io::install_stop_handlers();
-  const std::uint32_t stops = io::stop_count();
+  // main() installed the handlers at start: a signal during the start-up (making the RCU)
+  // counts too, rather than being lost while the console waits for input for ever.
+  const std::uint32_t stops = 0;
   int status = kOk;
   {
-    io::StopAwareInput buffer(STDIN_FILENO);
+    io::StopAwareInput buffer(STDIN_FILENO, stops);
     std::istream in(&buffer);
     std::string line;
-    while (io::stop_count() == stops && std::getline(in, line)) {
+    std::string too_long;  // a line refused by its length
+    while (io::stop_count() == stops && io::read_line(in, line, too_long)) {
+      if (!too_long.empty()) {
+        io::eprint("error: {}\n", too_long);
+        status = kFailure;
+        continue;
+      }
       if (!run_line(*rcu, line, stops)) status = kFailure;
     }
     if (buffer.error() != 0) {

@@ -21,6 +21,7 @@
 #include "rccx/hw/rcu.hpp"
 #include "rccx/hw/simulated_arm.hpp"
 #include "rccx/io/console.hpp"
+#include "rccx/io/input.hpp"
 #include "rccx/io/parse.hpp"
 #include "rccx/io/signals.hpp"
 #include "rccx/math/units.hpp"
@@ -74,7 +75,8 @@ void add_rtc_options(CLI::App& cmd, RtcArgs& a) {
   add_robot_options(cmd, a.robot);
   cmd.add_option("--period", a.period,
                  "Sample period, 0.25ms to 56ms (e.g. 1ms, 28ms); default 28ms for the Microbo "
-                 "(its bus needs about 10 ms a sample), 10ms for the others");
+                 "(its bus needs about 10 ms a sample), 10ms for the others")
+      ->check(not_empty());
   cmd.add_flag("--realtime", a.realtime,
                "Run in real time (SCHED_FIFO when allowed) instead of simulated time, which is "
                "deterministic and runs as fast as the machine allows");
@@ -82,7 +84,8 @@ void add_rtc_options(CLI::App& cmd, RtcArgs& a) {
                "Start the simulated robot uncalibrated (encoders relative to power-up)");
   cmd.add_option("--log", a.log,
                  "Write every controlled sample to this CSV file: t,seg,q1..,qm1..,x,y,z,ax,ay,az "
-                 "(s, rad or m; the environment's RCCX_LOG does the same for any program)");
+                 "(s, rad or m; the environment's RCCX_LOG does the same for any program)")
+      ->check(not_empty());
 }
 
 /// The simulated robot the options ask for, its errors turned into bad arguments.
@@ -374,6 +377,7 @@ struct ServoRamp {
   double target = 0.0;  ///< range value
   double speed = 0.0;   ///< per second
   double at = 0.0;      ///< the last POSVEL target
+  bool fresh = false;   ///< started this sample: the joint is stopped first
 };
 
 /// The test program's letters for joint controller settings.
@@ -438,9 +442,15 @@ int run_jointtest(const RtcArgs& a) {
           ramp->active = false;
           c.chg().pos(cmd.joint, cmd.value, cmd.speed);
           break;
-        case 'M':
-          *ramp = {true, cmd.joint, cmd.value, cmd.speed, c.how().joint[cmd.joint].range};
+        case 'M': {
+          // Stopped where it is first: the ramp's first step is then one step from the last
+          // target, also when an `m` move was under way (its target far ahead of the joint, a
+          // jump RTC would refuse as too fast).
+          const double here = c.how().joint[cmd.joint].range;
+          *ramp = {true, cmd.joint, cmd.value, cmd.speed, here, true};
+          c.chg().pos(cmd.joint, here);
           break;
+        }
         case 's':
           ramp->active = false;
           c.chg().pos(cmd.joint, c.how().joint[cmd.joint].range);
@@ -475,6 +485,10 @@ int run_jointtest(const RtcArgs& a) {
   // M: POSVEL every sample along a ramp at the joint's velocity.
   const auto f2 = [ramp](rtc::Control& c) {
     if (!ramp->active) return;
+    if (ramp->fresh) {  // this sample stops the joint (f1); the ramp starts at the next
+      ramp->fresh = false;
+      return;
+    }
     const double step = ramp->speed * c.period_s();
     ramp->at += std::clamp(ramp->target - ramp->at, -step, step);
     c.chg().posvel(ramp->joint, ramp->at);
@@ -482,7 +496,8 @@ int run_jointtest(const RtcArgs& a) {
   };
   // Ctrl-C ends the program (the arm holds) rather than control: the loop sees the stop count.
   r.session->set_hangup_handler([](rtc::Session&) {});
-  const std::uint32_t stops = io::stop_count();
+  // main() installed the handlers at start: a signal during the start-up counts too.
+  const std::uint32_t stops = 0;
   const auto stopped = [stops] { return io::stop_count() != stops; };
   const auto start = [&] { r.session->control(f1, f2); };
   start();
@@ -525,11 +540,16 @@ int run_jointtest(const RtcArgs& a) {
 
   fmt::print("jointtest on {} ({} joints), {} time, period {:.3f} ms. ? for the menu.\n", m.title,
              m.dof(), r.simulated() ? "simulated" : "real", r.period_s() * 1e3);
-  io::StopAwareInput buffer(STDIN_FILENO);  // ends a wait for a line on Ctrl-C / SIGTERM
+  io::StopAwareInput buffer(STDIN_FILENO, stops);  // ends a wait for a line on Ctrl-C / SIGTERM
   std::istream input(&buffer);
   std::string line;
+  std::string too_long;  // a line refused by its length
   bool quit = false;
-  while (!quit && !stopped() && std::getline(input, line)) {
+  while (!quit && !stopped() && io::read_line(input, line, too_long)) {
+    if (!too_long.empty()) {
+      failed(too_long);
+      continue;
+    }
     JointtestLine c;
     try {
       c = parse_jointtest_line(line, m, joint);

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <iostream>
 
 #include "rccx/io/console.hpp"
@@ -34,12 +35,26 @@ struct StopHandlers {
 int run_teach(const TeachArgs& a) {
   const std::string file = database_file(a.db);
   const StopHandlers handlers;
+  // The robot first: a bad --robot or --robot-file must not create the database (exit 2 changes
+  // nothing).
+  kin::RobotModel model = a.robot.model();
+  // A database path that names a directory or a device is bad input, as for `rccx db`.
+  std::error_code ec;
+  if (const auto type = std::filesystem::status(file, ec).type();
+      !ec && type != std::filesystem::file_type::not_found &&
+      type != std::filesystem::file_type::regular) {
+    throw BadArgument{fmt::format(
+        "position database {} is {}; name a database file with --db or RCCX_DB", io::quoted(file),
+        type == std::filesystem::file_type::directory ? "a directory" : "not a regular file")};
+  }
   try {
+    rtc::SimulatedRobot robot(std::move(model));
     rccl::PositionDb db(file);
-    rtc::SimulatedRobot robot(a.robot.model());
     rccl::Manipulator arm(*robot.session);
     arm.start();
-    io::StopAwareInput input(STDIN_FILENO);  // Ctrl-C ends a wait for a line
+    // Ctrl-C ends a wait for a line; also one during the start-up (main() installed the
+    // handlers at start).
+    io::StopAwareInput input(STDIN_FILENO, 0);
     std::istream in(&input);
     const rccl::Taught t = rccl::teach_loop(
         arm, {in, std::cout, &db, [&](std::size_t j, double e) { robot.push(j, e); }});
@@ -84,7 +99,8 @@ void add_teach_command(CLI::App& app, int& exit_code) {
       "stdin: Z / z zero gravity, push J E S, m J V (deg or mm), p pendant mode (J+ J- x+ rx- "
       "s V q), xd / xr / xR examine, h / H hand, save NAME (to the database), e exit, ? menu.");
   add_robot_options(*cmd, args->robot);
-  cmd->add_option("--db", args->db, "Position database (default $RCCX_DB, else ./rccx.db)");
+  cmd->add_option("--db", args->db, "Position database (default $RCCX_DB, else ./rccx.db)")
+      ->check(not_empty());
   cmd->callback([args, &exit_code] { guarded(exit_code, [&] { return run_teach(*args); }); });
 }
 

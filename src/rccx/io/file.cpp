@@ -24,15 +24,49 @@ int write_all(int fd, const char* data, std::size_t size) noexcept {
   return 0;
 }
 
-AtomicFile::AtomicFile(std::filesystem::path target) : target_(std::move(target)) {
+namespace {
+
+/// `path` with its symbolic links followed, also one that names a file not yet made.
+std::filesystem::path followed(std::filesystem::path path) {
   std::error_code ec;
-  if (std::filesystem::is_directory(target_, ec)) {
+  for (int hops = 0; hops < 40 && std::filesystem::is_symlink(path, ec); ++hops) {
+    const std::filesystem::path link = std::filesystem::read_symlink(path, ec);
+    if (ec) break;
+    path = link.is_absolute() ? link : path.parent_path() / link;
+  }
+  return path;
+}
+
+}  // namespace
+
+AtomicFile::AtomicFile(std::filesystem::path target) : target_(std::move(target)) {
+  struct stat st {};
+  const bool exists = ::stat(target_.c_str(), &st) == 0;
+  if (exists && S_ISDIR(st.st_mode)) {
     throw FileError(
         fmt::format("cannot write {}: it is a directory; name a file", target_.string()));
   }
+  // A device or a pipe (/dev/null, a named pipe), and whatever /dev/stdout or /dev/fd/N names
+  // (the shell's redirection): written in place.
+  const std::string& name = target_.native();
+  if ((exists && !S_ISREG(st.st_mode)) || name.starts_with("/dev/") || name.starts_with("/proc/")) {
+    // O_NONBLOCK: a named pipe nobody reads is an error now, not a wait for ever.
+    // O_APPEND for a regular file behind /dev/stdout: after what the shell's stdout wrote.
+    const int append = exists && S_ISREG(st.st_mode) ? O_APPEND : 0;
+    fd_ = ::open(target_.c_str(), O_WRONLY | O_CLOEXEC | O_NONBLOCK | append);
+    if (fd_ < 0) {
+      throw FileError(
+          fmt::format("cannot write {}: {}", target_.string(),
+                      errno == ENXIO ? "no process reads this named pipe" : std::strerror(errno)));
+    }
+    ::fcntl(fd_, F_SETFL, ::fcntl(fd_, F_GETFL) & ~O_NONBLOCK);
+    in_place_ = true;
+    return;
+  }
+  destination_ = followed(target_);
   const std::filesystem::path dir =
-      target_.has_parent_path() ? target_.parent_path() : std::filesystem::path(".");
-  std::string pattern = (dir / ("." + target_.filename().string() + ".tmp-XXXXXX")).string();
+      destination_.has_parent_path() ? destination_.parent_path() : std::filesystem::path(".");
+  std::string pattern = (dir / ("." + destination_.filename().string() + ".tmp-XXXXXX")).string();
   fd_ = ::mkstemp(pattern.data());
   if (fd_ < 0) {
     throw FileError(fmt::format("cannot write {}: {} (cannot create a file in {})",
@@ -53,8 +87,12 @@ AtomicFile::~AtomicFile() {
 void AtomicFile::fail(const char* doing, int error) {
   if (fd_ >= 0) ::close(fd_);
   fd_ = -1;
-  ::unlink(temporary_.c_str());
+  if (!temporary_.empty()) ::unlink(temporary_.c_str());
   temporary_.clear();
+  if (in_place_) {
+    throw FileError(fmt::format("cannot write {}: {} while {}; what it got is incomplete",
+                                target_.string(), std::strerror(error), doing));
+  }
   throw FileError(fmt::format("cannot write {}: {} while {}; {} was left as it was",
                               target_.string(), std::strerror(error), doing, target_.string()));
 }
@@ -66,17 +104,24 @@ void AtomicFile::write(std::string_view data) {
 
 void AtomicFile::commit() {
   if (fd_ < 0) throw FileError(fmt::format("cannot write {}: already closed", target_.string()));
+  if (in_place_) {  // a device or a pipe: nothing to rename, and no fsync to ask of it
+    const int fd = fd_;
+    fd_ = -1;
+    if (::close(fd) != 0) fail("closing", errno);
+    committed_ = true;
+    return;
+  }
   if (::fsync(fd_) != 0) fail("flushing to disk", errno);
   if (::close(fd_) != 0) {
     fd_ = -1;
     fail("closing", errno);
   }
   fd_ = -1;
-  if (::rename(temporary_.c_str(), target_.c_str()) != 0) fail("renaming into place", errno);
+  if (::rename(temporary_.c_str(), destination_.c_str()) != 0) fail("renaming into place", errno);
   committed_ = true;
   // The rename itself is durable only once the directory is.
   const std::filesystem::path dir =
-      target_.has_parent_path() ? target_.parent_path() : std::filesystem::path(".");
+      destination_.has_parent_path() ? destination_.parent_path() : std::filesystem::path(".");
   if (const int d = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY); d >= 0) {
     ::fsync(d);
     ::close(d);
@@ -90,7 +135,9 @@ void write_file_atomically(const std::filesystem::path& target, std::string_view
 }
 
 std::string read_file(const std::filesystem::path& file, std::size_t max_bytes) {
-  const int fd = ::open(file.c_str(), O_RDONLY | O_CLOEXEC);
+  // O_NONBLOCK: opening a named pipe nobody writes would otherwise wait for ever; it is
+  // refused below like any other file that is not a regular one.
+  const int fd = ::open(file.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
   if (fd < 0) {
     throw FileError(fmt::format("cannot read {}: {}", file.string(), std::strerror(errno)));
   }
@@ -98,9 +145,12 @@ std::string read_file(const std::filesystem::path& file, std::size_t max_bytes) 
   if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
     const bool dir = S_ISDIR(st.st_mode);
     ::close(fd);
-    throw FileError(fmt::format("cannot read {}: {}", file.string(),
-                                dir ? "it is a directory; name a file" : "not a regular file"));
+    throw FileError(
+        fmt::format("cannot read {}: {}", file.string(),
+                    dir ? "it is a directory; name a file"
+                        : "not a regular file (a device or a named pipe); name a regular file"));
   }
+  ::fcntl(fd, F_SETFL, ::fcntl(fd, F_GETFL) & ~O_NONBLOCK);
   std::string out;
   char chunk[65536];
   for (;;) {

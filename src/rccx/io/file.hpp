@@ -27,7 +27,11 @@ int write_all(int fd, const char* data, std::size_t size) noexcept;
 
 class AtomicFile {
  public:
-  /// Creates the temporary file beside `target` (throws FileError when it cannot).
+  /// Creates the temporary file beside `target` (throws FileError when it cannot). A symbolic
+  /// link is followed: the file it names is replaced and the link stays. A target that exists
+  /// and is not a regular file (a device such as /dev/null, a named pipe), and a path under /dev
+  /// or /proc (/dev/stdout), are written in place: replacing them would put a regular file
+  /// where the device was, or beside the file the shell opened.
   explicit AtomicFile(std::filesystem::path target);
   /// Removes the temporary file unless committed: the target is untouched.
   ~AtomicFile();
@@ -43,10 +47,12 @@ class AtomicFile {
  private:
   void fail(const char* doing, int error);
 
-  std::filesystem::path target_;
+  std::filesystem::path target_;       ///< as given, for messages
+  std::filesystem::path destination_;  ///< the target with its symbolic links followed
   std::filesystem::path temporary_;
   int fd_ = -1;
   bool committed_ = false;
+  bool in_place_ = false;  ///< a device or a named pipe: written directly
 };
 
 /// The whole of `data` as the new content of `target`, atomically (see above).

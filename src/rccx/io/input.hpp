@@ -11,7 +11,9 @@
 
 #include <array>
 #include <cstdint>
+#include <istream>
 #include <streambuf>
+#include <string>
 
 namespace rccx::io {
 
@@ -19,6 +21,9 @@ class StopAwareInput : public std::streambuf {
  public:
   /// Reads `fd`; stops at the first stop signal after construction.
   explicit StopAwareInput(int fd) noexcept;
+  /// Reads `fd`; stops once more than `stops_before` stop signals have arrived. A program that
+  /// installed the handlers at its start gives 0: a signal during its start-up counts.
+  StopAwareInput(int fd, std::uint32_t stops_before) noexcept;
   /// True when reading ended because of SIGINT / SIGTERM.
   [[nodiscard]] bool stopped() const noexcept { return stopped_; }
   /// True when reading ended because of a read error (not end of input).
@@ -34,5 +39,15 @@ class StopAwareInput : public std::streambuf {
   int error_ = 0;
   std::array<char, 4096> buffer_{};
 };
+
+/// The longest console line: a command is a few words.
+inline constexpr std::size_t kMaxLineBytes = 4096;
+
+/// std::getline with a bound, for consoles: false at the end of input. A line longer than
+/// `max_bytes` is refused whole (`problem` says so, `line` is empty) and the rest of it
+/// skipped; input that runs on for a MiB without a line end (/dev/zero, a binary file) is not
+/// commands: `problem` says so and the next call returns false. Memory stays bounded either way.
+bool read_line(std::istream& in, std::string& line, std::string& problem,
+               std::size_t max_bytes = kMaxLineBytes);
 
 }  // namespace rccx::io

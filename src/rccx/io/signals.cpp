@@ -32,6 +32,8 @@ std::mutex g_mutex;  // planning level only: install and restore
 int g_installed = 0;
 struct sigaction g_previous_int {};
 struct sigaction g_previous_term {};
+struct sigaction g_previous_hup {};
+bool g_hup_installed = false;
 
 }  // namespace
 
@@ -45,6 +47,11 @@ void install_stop_handlers() noexcept {
   sigemptyset(&sa.sa_mask);
   sigaction(SIGINT, &sa, &g_previous_int);
   sigaction(SIGTERM, &sa, &g_previous_term);
+  // SIGHUP (the terminal went away: a closed ssh session) stops cleanly too, so that a log is
+  // put in place rather than left as a temporary file; unless it is ignored (nohup).
+  sigaction(SIGHUP, nullptr, &g_previous_hup);
+  g_hup_installed = g_previous_hup.sa_handler != SIG_IGN;
+  if (g_hup_installed) sigaction(SIGHUP, &sa, nullptr);
 }
 
 void restore_stop_handlers() noexcept {
@@ -52,6 +59,7 @@ void restore_stop_handlers() noexcept {
   if (g_installed == 0 || --g_installed > 0) return;
   sigaction(SIGINT, &g_previous_int, nullptr);
   sigaction(SIGTERM, &g_previous_term, nullptr);
+  if (g_hup_installed) sigaction(SIGHUP, &g_previous_hup, nullptr);
 }
 
 std::uint32_t stop_count() noexcept {

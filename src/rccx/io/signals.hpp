@@ -1,4 +1,5 @@
-// SIGINT and SIGTERM as requests to stop, for the whole process. The handler only counts, keeps
+// SIGINT, SIGTERM and SIGHUP (unless ignored, as under nohup) as requests to stop, for the
+// whole process. The handler only counts, keeps
 // the signal's number and posts a semaphore (all async-signal-safe). It is installed without
 // SA_RESTART, so that a call blocked on a full pipe or a terminal returns (EINTR) instead of
 // holding the program: rccx's own waits retry EINTR or end cleanly (io::write_all, the
@@ -14,7 +15,7 @@
 
 namespace rccx::io {
 
-/// Installs the counting handler for SIGINT and SIGTERM; the dispositions it replaced are
+/// Installs the counting handler for SIGINT, SIGTERM and SIGHUP; the dispositions it replaced are
 /// returned by restore_stop_handlers(). Safe to call again (nesting is counted).
 void install_stop_handlers() noexcept;
 /// Undoes one install_stop_handlers(); the last one restores the earlier dispositions.
@@ -24,7 +25,8 @@ void restore_stop_handlers() noexcept;
 std::uint32_t stop_count() noexcept;
 /// The number of the last such signal (SIGINT or SIGTERM), 0 before the first.
 int last_stop_signal() noexcept;
-/// The exit status a shell gives a program ended by that signal: 128 + its number (130, 143).
+/// The exit status a shell gives a program ended by that signal: 128 + its number (130, 143,
+/// 129 for SIGHUP).
 int stop_exit_code() noexcept;
 
 /// Blocks until a stop signal arrives or wake_stop_waiter() is called (for one watcher thread).

@@ -7,6 +7,8 @@
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include "rccx/io/file.hpp"
 #include "rccx/io/parse.hpp"
@@ -238,10 +240,31 @@ Joint parse_joint(const json& j, const std::string& where) {
 
 namespace {
 
+/// A robot file is 6 levels deep (hardware, rcu, joints, a joint, motor_parameters); deeper
+/// nesting is refused while parsing, before recursion over it (dump(), the destructor) could
+/// overflow the stack.
+constexpr int kMaxDepth = 32;
+
 RobotModel parse_robot_json(std::string_view json_text, std::string_view origin) {
   json doc;
+  std::vector<std::set<std::string>> keys;  // one set per open object
+  const auto strict = [&](int depth, json::parse_event_t event, json& parsed) {
+    if (depth > kMaxDepth) {
+      throw RobotFileError(fmt::format(
+          "{}: nested more than {} deep; a robot file is 6 levels deep", origin, kMaxDepth));
+    }
+    if (event == json::parse_event_t::object_start) keys.emplace_back();
+    if (event == json::parse_event_t::object_end && !keys.empty()) keys.pop_back();
+    // The JSON library would keep the last of a repeated key silently.
+    if (event == json::parse_event_t::key && !keys.empty() &&
+        !keys.back().insert(parsed.get<std::string>()).second) {
+      throw RobotFileError(fmt::format("{}: key {} is given twice in one object; give it once",
+                                       origin, io::quoted(parsed.get<std::string>())));
+    }
+    return true;
+  };
   try {
-    doc = json::parse(json_text, nullptr, /*allow_exceptions=*/true, /*ignore_comments=*/true);
+    doc = json::parse(json_text, strict, /*allow_exceptions=*/true, /*ignore_comments=*/true);
   } catch (const json::exception& e) {  // syntax, or a number that overflows a double
     throw RobotFileError(fmt::format("{}: not valid JSON: {}", origin, e.what()));
   }

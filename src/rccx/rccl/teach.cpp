@@ -10,6 +10,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "rccx/io/input.hpp"
 #include "rccx/io/parse.hpp"
 #include "rccx/io/signals.hpp"
 #include "rccx/math/units.hpp"
@@ -203,8 +204,11 @@ class Loop {
     arm_.waitfor(arm_.completed());  // the program's motions end first
     say("{}", kMenu);
     std::string line;
-    while (!stopped() && prompt(pendant_ ? "pendant> " : "teach> ") && std::getline(io_.in, line)) {
+    std::string too_long;  // a line refused by its length
+    while (!stopped() && prompt(pendant_ ? "pendant> " : "teach> ") &&
+           io::read_line(io_.in, line, too_long)) {
       try {
+        if (!too_long.empty()) throw io::ParseError(too_long);
         const TeachCommand c = parse_teach_command(line, model_, pendant_);
         if (c.kind == TeachCommand::Kind::exit) return finish(true);
         execute(c);
