@@ -15,33 +15,6 @@
 namespace rccx::tools {
 namespace {
 
-/// The words of a line (split at blanks, tabs and a carriage return).
-std::vector<std::string_view> words_of(std::string_view line) {
-  std::vector<std::string_view> words;
-  std::size_t at = 0;
-  while (at < line.size()) {
-    const std::size_t begin = line.find_first_not_of(" \t\r", at);
-    if (begin == std::string_view::npos) break;
-    const std::size_t stop = std::min(line.find_first_of(" \t\r", begin), line.size());
-    words.push_back(line.substr(begin, stop - begin));
-    at = stop;
-  }
-  return words;
-}
-
-/// Throws unless the line has `count` words (the command and its arguments).
-void expect_words(const std::vector<std::string_view>& w, std::size_t count,
-                  std::string_view usage) {
-  if (w.size() < count) {
-    throw io::ParseError(fmt::format("{}: {} missing; write {}", w[0],
-                                     count - w.size() == 1 ? "a value is" : "values are", usage));
-  }
-  if (w.size() > count) {
-    throw io::ParseError(
-        fmt::format("{}: {} is one word too many; write {}", w[0], io::quoted(w[count]), usage));
-  }
-}
-
 bool revolute(const kin::Joint& j) {
   return j.type == kin::JointType::revolute;
 }
@@ -63,7 +36,7 @@ bool hex_of(std::string_view text, std::size_t digits, unsigned& value) {
 
 JointtestLine parse_jointtest_line(std::string_view line, const kin::RobotModel& model,
                                    std::size_t joint) {
-  const std::vector<std::string_view> w = words_of(line);
+  const std::vector<std::string_view> w = io::words_of(line);
   JointtestLine c;
   if (w.empty()) return c;
   if (w[0].size() != 1) {
@@ -82,14 +55,14 @@ JointtestLine parse_jointtest_line(std::string_view line, const kin::RobotModel&
     case 'X':
     case 'q':
     case '?':
-      expect_words(w, 1, w[0]);
+      io::expect_words(w, 1, w[0]);
       return c;
     case 'j':
-      expect_words(w, 2, "j N, the joint number");
+      io::expect_words(w, 2, "j N, the joint number");
       c.joint = io::parse_joint(w[1], "j: the joint", model.dof());
       return c;
     case 'v': {
-      expect_words(w, 2, revolute(jm) ? "v V, a speed in deg/s" : "v V, a speed in mm/s");
+      io::expect_words(w, 2, revolute(jm) ? "v V, a speed in deg/s" : "v V, a speed in mm/s");
       const double max = revolute(jm) ? math::rad_to_deg(jm.max_velocity) : jm.max_velocity * 1e3;
       const std::string what = fmt::format("v: joint {}'s speed", joint + 1);
       c.value = io::parse_number(w[1], what, {1e-3, max, revolute(jm) ? "deg/s" : "mm/s"});
@@ -97,26 +70,26 @@ JointtestLine parse_jointtest_line(std::string_view line, const kin::RobotModel&
     }
     case 'm':
     case 'M': {
-      expect_words(w, 2, revolute(jm) ? "m V, a position in deg" : "m V, a position in mm");
+      io::expect_words(w, 2, revolute(jm) ? "m V, a position in deg" : "m V, a position in mm");
       const std::string what = fmt::format("{}: joint {}'s target", c.letter, joint + 1);
       c.value = io::parse_number(w[1], what, {-kMaxJointtestTarget, kMaxJointtestTarget, unit});
       return c;
     }
     case 'o':
     case 'O':
-      expect_words(w, 2, "o B or O B, with B an output bit 0 to 15");
+      io::expect_words(w, 2, "o B or O B, with B an output bit 0 to 15");
       c.value = static_cast<double>(
           io::parse_integer(w[1], fmt::format("{}: the output bit", c.letter), 0, 15));
       return c;
     case 'w':
-      expect_words(w, 2, "w S, a time in seconds (e.g. w 2, w 500ms)");
+      io::expect_words(w, 2, "w S, a time in seconds (e.g. w 2, w 500ms)");
       c.duration = io::parse_duration(w[1], "w: the wait", io::BareUnit::seconds,
                                       std::chrono::nanoseconds{0},
                                       std::chrono::duration_cast<std::chrono::nanoseconds>(
                                           std::chrono::duration<double>(kMaxJointtestWaitS)));
       return c;
     case 'r':
-      expect_words(w, 2, "r MS, the sample period (0.25 ms to 56 ms)");
+      io::expect_words(w, 2, "r MS, the sample period (0.25 ms to 56 ms)");
       c.duration = io::parse_duration(w[1], "r: the sample period", io::BareUnit::milliseconds,
                                       rtc::kMinPeriod, rtc::kMaxPeriod);
       return c;
@@ -126,7 +99,7 @@ JointtestLine parse_jointtest_line(std::string_view line, const kin::RobotModel&
     case 'K':
     case 'V':
     case 'z': {
-      expect_words(w, 2, "the letter and a whole number in the controller's units");
+      io::expect_words(w, 2, "the letter and a whole number in the controller's units");
       const std::int64_t hi = c.letter == 'a' ? 65535 : 255;
       c.value = static_cast<double>(
           io::parse_integer(w[1], fmt::format("{}: the value", c.letter), 0, hi));
@@ -139,7 +112,7 @@ JointtestLine parse_jointtest_line(std::string_view line, const kin::RobotModel&
 }
 
 RcuLine parse_rcu_line(std::string_view line, std::size_t dof) {
-  const std::vector<std::string_view> w = words_of(line);
+  const std::vector<std::string_view> w = io::words_of(line);
   RcuLine c;
   if (w.empty() || w[0][0] == '#') return c;
   const std::string registers =
@@ -154,7 +127,7 @@ RcuLine parse_rcu_line(std::string_view line, std::size_t dof) {
     return static_cast<std::uint16_t>(v);
   };
   if (w[0] == "out") {
-    expect_words(w, 3, "out ADDR BYTE, e.g. out 5801 0C (hex)");
+    io::expect_words(w, 3, "out ADDR BYTE, e.g. out 5801 0C (hex)");
     c.kind = RcuLine::Kind::out;
     c.address = address(w[1]);
     unsigned v = 0;
@@ -166,20 +139,20 @@ RcuLine parse_rcu_line(std::string_view line, std::size_t dof) {
     return c;
   }
   if (w[0] == "in") {
-    expect_words(w, 2, "in ADDR, with ADDR one of " + registers);
+    io::expect_words(w, 2, "in ADDR, with ADDR one of " + registers);
     c.kind = RcuLine::Kind::in;
     c.address = address(w[1]);
     return c;
   }
   if (w[0] == "step") {
-    expect_words(w, 2, "step MS, the emulated milliseconds to let pass, e.g. step 0.1");
+    io::expect_words(w, 2, "step MS, the emulated milliseconds to let pass, e.g. step 0.1");
     c.kind = RcuLine::Kind::step;
     const double ms = io::parse_number(w[1], "step: the time", {0.0, kMaxRcuStepMs, "ms"});
     c.step_us = std::llround(ms * 1000);
     return c;
   }
   if (w[0] == "fault") {
-    expect_words(w, 3, "fault JOINT KIND, e.g. fault 2 encoder_error");
+    io::expect_words(w, 3, "fault JOINT KIND, e.g. fault 2 encoder_error");
     c.kind = RcuLine::Kind::fault;
     try {
       c.joint = io::parse_joint(w[1], "fault: the joint", dof);

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cctype>
 #include <charconv>
 #include <cmath>
@@ -247,6 +248,31 @@ void check_name(std::string_view text, std::string_view what, std::size_t max_ch
           fmt::format("{}: {} is not a name; use letters, digits and _ - . only (no spaces)", what,
                       quoted(text)));
     }
+  }
+}
+
+std::vector<std::string_view> words_of(std::string_view line) {
+  std::vector<std::string_view> words;
+  std::size_t at = 0;
+  while (at < line.size()) {
+    const std::size_t begin = line.find_first_not_of(" \t\r", at);
+    if (begin == std::string_view::npos) break;
+    const std::size_t stop = std::min(line.find_first_of(" \t\r", begin), line.size());
+    words.push_back(line.substr(begin, stop - begin));
+    at = stop;
+  }
+  return words;
+}
+
+void expect_words(const std::vector<std::string_view>& words, std::size_t count,
+                  std::string_view usage) {
+  if (words.size() < count) {
+    throw ParseError(fmt::format("{}: {} missing; write {}", words[0],
+                                 count - words.size() == 1 ? "a value is" : "values are", usage));
+  }
+  if (words.size() > count) {
+    throw ParseError(fmt::format("{}: {} is one word too many; write {}", words[0],
+                                 quoted(words[count]), usage));
   }
 }
 

@@ -71,6 +71,14 @@ void check_text(std::string_view text, std::string_view what, std::size_t max_by
 /// A name (of a transform, robot, frame): 1 .. max_chars of ASCII letters, digits and _ - .
 void check_name(std::string_view text, std::string_view what, std::size_t max_chars);
 
+/// The words of a console line (split at blanks, tabs and a carriage return); views into `line`.
+std::vector<std::string_view> words_of(std::string_view line);
+
+/// Throws ParseError unless `words` (a command and its arguments, at least the command) has
+/// exactly `count` of them; the message names the command and shows `usage`.
+void expect_words(const std::vector<std::string_view>& words, std::size_t count,
+                  std::string_view usage);
+
 /// `text` quoted for an error message: non-printable bytes as \xNN, cut after 40 characters.
 std::string quoted(std::string_view text);
 

@@ -43,33 +43,6 @@ const char* user_unit(const kin::Joint& j) {
   return prismatic(j) ? "mm" : "deg";
 }
 
-/// The words of a line (split at blanks, tabs and a carriage return).
-std::vector<std::string_view> words_of(std::string_view line) {
-  std::vector<std::string_view> words;
-  std::size_t at = 0;
-  while (at < line.size()) {
-    const std::size_t begin = line.find_first_not_of(" \t\r", at);
-    if (begin == std::string_view::npos) break;
-    const std::size_t stop = std::min(line.find_first_of(" \t\r", begin), line.size());
-    words.push_back(line.substr(begin, stop - begin));
-    at = stop;
-  }
-  return words;
-}
-
-/// Throws unless the line has `count` words (the command and its arguments).
-void expect_words(const std::vector<std::string_view>& w, std::size_t count,
-                  std::string_view usage) {
-  if (w.size() < count) {
-    throw io::ParseError(fmt::format("{}: {} missing; write {}", w[0],
-                                     count - w.size() == 1 ? "a value is" : "values are", usage));
-  }
-  if (w.size() > count) {
-    throw io::ParseError(
-        fmt::format("{}: {} is one word too many; write {}", w[0], io::quoted(w[count]), usage));
-  }
-}
-
 /// A target for joint `j` in the operator's units, refused outside the joint's limits.
 double joint_goal(std::string_view text, const kin::Joint& j, std::size_t index) {
   const std::string what = fmt::format("m: joint {} ({}) target", index + 1, j.name);
@@ -84,17 +57,17 @@ TeachCommand pendant_command(const std::vector<std::string_view>& w, const kin::
   const std::string_view word = w[0];
   constexpr const char* kUsage = "J+ J- (joint J), x+ y- z+ (move), rx+ ry- rz+ (turn), s V, q";
   if (word == "q") {
-    expect_words(w, 1, "q");
+    io::expect_words(w, 1, "q");
     c.kind = Kind::leave_pendant;
     return c;
   }
   if (word == "e" || word == "?") {
-    expect_words(w, 1, word);
+    io::expect_words(w, 1, word);
     c.kind = word == "e" ? Kind::exit : Kind::menu;
     return c;
   }
   if (word == "s") {
-    expect_words(w, 2, "s V, the step in deg or mm, e.g. s 2");
+    io::expect_words(w, 2, "s V, the step in deg or mm, e.g. s 2");
     c.kind = Kind::set_step;
     c.value = io::parse_number(w[1], "s: the step", {1e-3, kMaxTeachStep, "deg or mm"});
     return c;
@@ -104,7 +77,7 @@ TeachCommand pendant_command(const std::vector<std::string_view>& w, const kin::
     throw io::ParseError(
         fmt::format("pendant: {} is not a pendant command; write {}", io::quoted(word), kUsage));
   }
-  expect_words(w, 1, kUsage);
+  io::expect_words(w, 1, kUsage);
   c.sign = sign == '+' ? 1 : -1;
   const std::string_view axis = word.substr(0, word.size() - 1);
   if (std::isdigit(static_cast<unsigned char>(axis[0])) != 0) {
@@ -129,7 +102,7 @@ TeachCommand pendant_command(const std::vector<std::string_view>& w, const kin::
 TeachCommand parse_teach_command(std::string_view line, const kin::RobotModel& model,
                                  bool pendant_mode) {
   using Kind = TeachCommand::Kind;
-  const std::vector<std::string_view> w = words_of(line);
+  const std::vector<std::string_view> w = io::words_of(line);
   TeachCommand c;
   if (w.empty()) return c;
   if (pendant_mode) return pendant_command(w, model);
@@ -150,13 +123,13 @@ TeachCommand parse_teach_command(std::string_view line, const kin::RobotModel& m
                                      {"H", Kind::hand_close}};
   for (const Plain& p : kPlain) {
     if (word == p.word) {
-      expect_words(w, 1, p.word);
+      io::expect_words(w, 1, p.word);
       c.kind = p.kind;
       return c;
     }
   }
   if (word == "push") {
-    expect_words(w, 4, "push J EFFORT SECONDS, e.g. push 1 5 0.5 (N m or N, s)");
+    io::expect_words(w, 4, "push J EFFORT SECONDS, e.g. push 1 5 0.5 (N m or N, s)");
     c.kind = Kind::push;
     c.joint = io::parse_joint(w[1], "push: the joint", model.dof());
     c.value =
@@ -165,20 +138,20 @@ TeachCommand parse_teach_command(std::string_view line, const kin::RobotModel& m
     return c;
   }
   if (word == "m") {
-    expect_words(w, 3, "m J VALUE, e.g. m 1 30 (deg, or mm)");
+    io::expect_words(w, 3, "m J VALUE, e.g. m 1 30 (deg, or mm)");
     c.kind = Kind::move_joint;
     c.joint = io::parse_joint(w[1], "m: the joint", model.dof());
     c.value = joint_goal(w[2], model.joints[c.joint], c.joint);
     return c;
   }
   if (word == "X") {
-    expect_words(w, 2, "X J, e.g. X 2");
+    io::expect_words(w, 2, "X J, e.g. X 2");
     c.kind = Kind::motor_parameters;
     c.joint = io::parse_joint(w[1], "X: the joint", model.dof());
     return c;
   }
   if (word == "save") {
-    expect_words(w, 2, "save NAME, e.g. save PICK");
+    io::expect_words(w, 2, "save NAME, e.g. save PICK");
     c.kind = Kind::save;
     io::check_name(w[1], "save: the name", kMaxTransformName);
     c.name = std::string(w[1]);
