@@ -179,6 +179,12 @@ TEST_F(BadInput, ControlPrograms) {
       {"", "nosuch", 2, "subcommand", ""},
       {"", "report --seconds 0.2 --every 0.1", 0, "theta", ""},
       {"", "calib --robot puma560 --uncalibrated --timeout 60", 0, "ALL JOINTS", ""},
+      {"", "cell-load --robots 0", 2, "--robots", ""},
+      {"", "cell-load --robots 2 --period 0.1ms", 2, "--period", ""},
+      {"", "cell-load --robots 2 --seconds inf", 2, "--seconds", ""},
+      {"", "cell-load --robots 2 --robot microbo", 2, "puma560 or puma260", ""},
+      {"", "cell-load --robots 2 --spacing 0.5", 2, "--spacing", ""},
+      {"", "cell-load --robots 3 --seconds 0.3", 0, "cycle compute over 30", ""},
   });
 }
 

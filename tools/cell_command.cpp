@@ -7,8 +7,13 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "rccx/cell/cell.hpp"
 #include "rccx/cell/cell_model.hpp"
+#include "rccx/cell/load.hpp"
+#include "rccx/io/parse.hpp"
+#include "rccx/io/signals.hpp"
 #include "rccx/math/units.hpp"
+#include "rccx/rtc/session.hpp"
 
 namespace rccx::tools {
 
@@ -152,6 +157,92 @@ int run_show(const ShowArgs& args) {
   return kOk;
 }
 
+struct LoadArgs {
+  std::string robots = "8";
+  std::string period = "1ms";
+  std::string seconds = "2";
+  std::string robot = "puma560";
+  std::string spacing = "2.5";
+  bool realtime = false;
+  bool plant = false;
+  bool json = false;
+};
+
+int run_load(const LoadArgs& a) {
+  std::size_t n = 0;
+  std::chrono::nanoseconds period{};
+  double seconds = 0, spacing = 0;
+  try {
+    n = static_cast<std::size_t>(io::parse_integer(a.robots, "--robots", 1, 4096));
+    period = io::parse_duration(a.period, "--period", io::BareUnit::milliseconds, rtc::kMinPeriod,
+                                rtc::kMaxPeriod);
+    seconds = io::parse_seconds(a.seconds, "--seconds", 1e-3, 3600);
+    spacing = io::parse_number(a.spacing, "--spacing", {1.0, 100.0, "m"});
+  } catch (const io::ParseError& e) {
+    throw BadArgument{e.what()};
+  }
+  if (a.robot != "puma560" && a.robot != "puma260") {
+    throw BadArgument{fmt::format("--robot: {} is not one the load drives; give puma560 or puma260",
+                                  io::quoted(a.robot))};
+  }
+  cell::CellOptions options;
+  options.clock = a.realtime ? rtc::ClockKind::real_time : rtc::ClockKind::simulated;
+  options.ideal_servo = !a.plant;
+  cell::Cell c(cell::grid_cell(n, a.robot, spacing, period), options);
+  if (!a.json) {
+    fmt::print("cell-load: {} {} on a {:g} m grid, {} at {:g} ms, {} time, {} s\n", n, a.robot,
+               spacing, a.plant ? "each on its plant" : "ideal servos",
+               std::chrono::duration<double, std::milli>(period).count(),
+               a.realtime ? "real" : "simulated", seconds);
+  }
+  cell::start_circles(c);
+  const auto run_for =
+      std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::duration<double>(seconds));
+  if (a.realtime) {
+    // Real time: the tasks tick on their own; wait in period steps so Ctrl-C ends it soon.
+    const auto until = std::chrono::steady_clock::now() + run_for;
+    while (std::chrono::steady_clock::now() < until && io::stop_count() == 0) {
+      c.wait_for(std::min<std::chrono::nanoseconds>(run_for, std::chrono::milliseconds(100)));
+    }
+  } else {
+    c.wait_for(run_for);
+  }
+  const rtc::LatencyStats compute = c.group().compute();
+  const rtc::LatencyStats wake = c.group().latency();
+  std::size_t failed = 0;
+  for (const auto& name : c.robot_names()) failed += c.robot(name).failures().empty() ? 0 : 1;
+  const double period_us = std::chrono::duration<double, std::micro>(period).count();
+  if (a.json) {
+    nlohmann::ordered_json j{{"robots", n},
+                             {"period_us", period_us},
+                             {"realtime", a.realtime},
+                             {"ticks", compute.wakeups},
+                             {"compute_p50_us", compute.p50_us},
+                             {"compute_p99_us", compute.p99_us},
+                             {"compute_p999_us", compute.p999_us},
+                             {"compute_max_us", compute.max_us},
+                             {"wakeup_p50_us", wake.p50_us},
+                             {"wakeup_p99_us", wake.p99_us},
+                             {"wakeup_max_us", wake.max_us},
+                             {"missed_deadlines", wake.missed_deadlines},
+                             {"robots_failed", failed}};
+    fmt::print("{}\n", j.dump(2));
+  } else {
+    fmt::print(
+        "cycle compute over {} ticks: p50 {:.1f} us, p99 {:.1f} us, p99.9 {:.1f} us, max {:.1f} us "
+        "({:.1f} % of the period at p99; {:.2f} us a robot at p50)\n",
+        compute.wakeups, compute.p50_us, compute.p99_us, compute.p999_us, compute.max_us,
+        100.0 * compute.p99_us / period_us, compute.p50_us / static_cast<double>(n));
+    if (a.realtime) {
+      fmt::print(
+          "wake-up latency: p50 {:.0f} us, p99 {:.0f} us, max {:.0f} us; missed deadlines {}\n",
+          wake.p50_us, wake.p99_us, wake.max_us, wake.missed_deadlines);
+    }
+    if (failed > 0) fmt::print("{} robots' motions failed (see docs/CELL.md)\n", failed);
+  }
+  return failed > 0 ? kFailure : kOk;
+}
+
 }  // namespace
 
 void add_cell_command(CLI::App& app, int& exit_code) {
@@ -172,6 +263,28 @@ void add_cell_command(CLI::App& app, int& exit_code) {
   show_cmd->add_flag("--json", show->json,
                      "Print JSON in SI units (keys say them: _m, _m3, _ms, _deg)");
   show_cmd->callback([show, &exit_code] { guarded(exit_code, [&] { return run_show(*show); }); });
+
+  auto load = std::make_shared<LoadArgs>();
+  CLI::App* load_cmd = app.add_subcommand(
+      "cell-load",
+      "Drives N simulated PUMAs on one clock (a square grid, each tracking a 20 mm circle in "
+      "Cartesian mode through a functional transform, collision checks on) and prints the "
+      "cycle's computing time (from the communication task's wake-up to the end of the control "
+      "cycle) in percentiles, and in real time the wake-up latency and missed deadlines");
+  load_cmd->add_option("--robots", load->robots, "How many robots (1 to 4096)")
+      ->capture_default_str();
+  load_cmd->add_option("--period", load->period, "The clock's period (0.25ms to 56ms)")
+      ->capture_default_str();
+  load_cmd->add_option("--seconds", load->seconds, "How long to run: s, or with a unit")
+      ->capture_default_str();
+  load_cmd->add_option("--robot", load->robot, "puma560 or puma260")->capture_default_str();
+  load_cmd->add_option("--spacing", load->spacing, "Grid spacing, m")->capture_default_str();
+  load_cmd->add_flag("--realtime", load->realtime,
+                     "Real time (SCHED_FIFO when allowed) instead of simulated time");
+  load_cmd->add_flag("--plant", load->plant,
+                     "Each robot on the PUMA's PID and plant instead of an ideal servo");
+  load_cmd->add_flag("--json", load->json, "Print the figures as JSON (us)");
+  load_cmd->callback([load, &exit_code] { guarded(exit_code, [&] { return run_load(*load); }); });
 }
 
 }  // namespace rccx::tools

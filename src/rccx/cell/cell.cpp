@@ -83,7 +83,7 @@ Cell::Cell(CellModel model, CellOptions options)
     const CellRobot& cr = model_.robots[i];
     auto r = std::make_unique<Robot>();
     r->name = cr.name;
-    r->hardware = rtc::make_simulated_hardware(cr.model);
+    r->hardware = rtc::make_simulated_hardware(cr.model, true, options_.ideal_servo);
     r->session = &group_->add(*r->hardware.driver, static_cast<int>(cr.period_multiple));
     r->manipulator = std::make_unique<rccl::Manipulator>(*r->session);
     r->base_inverse = cr.base.inverse();

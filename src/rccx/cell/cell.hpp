@@ -56,6 +56,9 @@ struct CellOptions {
   bool real_time_scheduling = true;
   /// Stop two arms before their capsules come within the cell's margin.
   bool collision_checks = true;
+  /// Every robot on an ideal servo (hw::IdealArm) instead of its plant (the PUMA's PID on
+  /// its dynamics, the Microbo's RCU): for load tests of the cycle itself.
+  bool ideal_servo = false;
 };
 
 /// A robot's commanded tool frame in the world at one instant, as the control task publishes it.

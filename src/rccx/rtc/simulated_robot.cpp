@@ -1,5 +1,6 @@
 #include "rccx/rtc/simulated_robot.hpp"
 
+#include "rccx/hw/ideal_arm.hpp"
 #include "rccx/rtc/microbo_driver.hpp"
 #include "rccx/rtc/servo_driver.hpp"
 
@@ -10,11 +11,15 @@ std::chrono::nanoseconds SimulatedRobot::usual_period(const kin::RobotModel& mod
   return model.hardware_json.empty() ? milliseconds(10) : milliseconds(28);
 }
 
-SimulatedHardware make_simulated_hardware(const kin::RobotModel& model, bool calibrated) {
+SimulatedHardware make_simulated_hardware(const kin::RobotModel& model, bool calibrated,
+                                          bool ideal_servo) {
   SimulatedHardware h;
   hw::SimulatedArmOptions arm_options;
   arm_options.calibrated = calibrated;
-  if (!model.hardware_json.empty()) {
+  if (ideal_servo) {
+    h.arm = std::make_unique<hw::IdealArm>(model, arm_options);
+    h.driver = std::make_unique<ServoDriver>(*h.arm);
+  } else if (!model.hardware_json.empty()) {
     h.rcu = std::make_unique<hw::Rcu>(model, arm_options);
     h.bus = std::make_unique<hw::RcuBus>(*h.rcu);
     MicroboDriverOptions o;

@@ -37,7 +37,8 @@ struct SimulatedHardware {
 
 /// Builds the hardware and driver of `model` (the Microbo's RCU when the robot file describes
 /// one, else a servo arm). Throws std::invalid_argument when the robot cannot be simulated.
-SimulatedHardware make_simulated_hardware(const kin::RobotModel& model, bool calibrated = true);
+SimulatedHardware make_simulated_hardware(const kin::RobotModel& model, bool calibrated = true,
+                                          bool ideal_servo = false);
 
 struct SimulatedRobot {
   /// Throws std::invalid_argument when the robot cannot be simulated, SessionError for a bad

@@ -1,0 +1,27 @@
+// A load for the cell's cycle: N robots of one kind on a square grid, each tracking a small
+// circle in Cartesian mode through a functional transform (inverse kinematics and a functional
+// evaluation every sample, collision checks between neighbours). What BM_CellCycle and
+// `rccx cell-load` measure.
+#pragma once
+
+#include <chrono>
+#include <cstddef>
+#include <string_view>
+
+#include "rccx/cell/cell.hpp"
+#include "rccx/cell/cell_model.hpp"
+
+namespace rccx::cell {
+
+/// `count` robots `robot` (a shipped robot) on a square grid `spacing_m` apart, every one at
+/// `period`, with `link_radius_m` capsules and a 10 mm collision margin.
+CellModel grid_cell(std::size_t count, std::string_view robot, double spacing_m,
+                    std::chrono::nanoseconds period, double link_radius_m = 0.05);
+
+/// Starts `cell` and sets every robot (a PUMA 560 or 260) moving: a joint move to a pose in
+/// front of it, then, in Cartesian mode, onto a 20 mm circle it goes round every 5 s for as long
+/// as the cell runs. Returns once every move is queued. Throws rccl::MotionError when a robot
+/// cannot reach its circle.
+void start_circles(Cell& cell);
+
+}  // namespace rccx::cell
