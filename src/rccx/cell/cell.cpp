@@ -100,18 +100,21 @@ Cell::Cell(CellModel model, CellOptions options)
     const rccl::GeneratorOptions& g = r->manipulator->generator().options();
     kin::JointVector q1 = ready;
     for (std::size_t j = 0; j < q1.size(); ++j) q1[j] += g.max_velocity[j] * r->period_s;
-    widest_allowance_m +=
-        braking_m(cr.model, ready, q1, g.max_acceleration, r->period_s, r->lever_m);
+    widest_allowance_m =
+        std::max(widest_allowance_m,
+                 braking_m(cr.model, ready, q1, g.max_acceleration, r->period_s, r->lever_m));
     robots_.push_back(std::move(r));
   }
   // The world reports every pair that could need a stop; on_cycle compares each with the
   // margin plus the two robots' allowances at that tick.
+  // Two robots' allowances at most, whatever their number: the broad phase stays local.
   world_ = std::make_unique<CollisionWorld>(std::move(capsules),
-                                            model_.collision_margin_m + widest_allowance_m);
+                                            model_.collision_margin_m + 2.0 * widest_allowance_m);
   const std::size_t n = robots_.size();
   contacts_.resize(n * (n - 1) / 2 + 1);
   last_distance_m_.assign(n * n, kInf);
   seen_.assign(n * n, 0);
+  tracked_.reserve(contacts_.size());  // the loop pushes within it: no allocation
   group_->set_cycle_hook([this](std::uint32_t tick) { on_cycle(tick); });
 }
 
@@ -275,8 +278,8 @@ void Cell::check_collisions() noexcept {
   const std::size_t found = world_->contacts(contacts_);
   // A pair not reported is farther than the world's margin: as good as infinitely far.
   std::vector<double>& last = last_distance_m_;
-  std::fill(seen_.begin(), seen_.end(), std::uint8_t{0});
-  for (std::size_t k = 0; k < std::min(found, contacts_.size()); ++k) {
+  const std::size_t reported = std::min(found, contacts_.size());
+  for (std::size_t k = 0; k < reported; ++k) {
     const Contact& c = contacts_[k];
     Robot& a = *robots_[c.robot_a];
     Robot& b = *robots_[c.robot_b];
@@ -304,8 +307,15 @@ void Cell::check_collisions() noexcept {
     b.manipulator->generator().request_stop(why);
     collision_stops_.fetch_add(1, std::memory_order_acq_rel);
   }
-  for (std::size_t pair = 0; pair < n * n; ++pair) {
+  // Pairs reported last tick and not now are far again; only those are visited (not n^2).
+  for (const std::size_t pair : tracked_) {
     if (seen_[pair] == 0) last[pair] = kInf;
+  }
+  tracked_.clear();
+  for (std::size_t k = 0; k < reported; ++k) {
+    const std::size_t pair = contacts_[k].robot_a * n + contacts_[k].robot_b;
+    tracked_.push_back(pair);
+    seen_[pair] = 0;
   }
 }
 
