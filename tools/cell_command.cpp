@@ -174,13 +174,12 @@ int run_load(const LoadArgs& a) {
   double seconds = 0, spacing = 0;
   try {
     n = static_cast<std::size_t>(io::parse_integer(a.robots, "--robots", 1, 4096));
-    period = io::parse_duration(a.period, "--period", io::BareUnit::milliseconds, rtc::kMinPeriod,
-                                rtc::kMaxPeriod);
     seconds = io::parse_seconds(a.seconds, "--seconds", 1e-3, 3600);
     spacing = io::parse_number(a.spacing, "--spacing", {1.0, 100.0, "m"});
   } catch (const io::ParseError& e) {
     throw BadArgument{e.what()};
   }
+  period = parse_period(a.period);
   if (a.robot != "puma560" && a.robot != "puma260") {
     throw BadArgument{fmt::format("--robot: {} is not one the load drives; give puma560 or puma260",
                                   io::quoted(a.robot))};

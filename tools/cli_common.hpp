@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <CLI/CLI.hpp>
+#include <chrono>
 #include <cstdlib>
 #include <memory>
 #include <string>
@@ -12,6 +13,7 @@
 #include "rccx/io/file.hpp"
 #include "rccx/io/parse.hpp"
 #include "rccx/kinematics/kinematics.hpp"
+#include "rccx/rtc/session.hpp"
 
 namespace rccx::tools {
 
@@ -33,6 +35,17 @@ inline CLI::Validator not_empty() {
                              : std::string();
       },
       "", "NOT_EMPTY");
+}
+
+/// A sample period ("1ms", "250us", "0.028s"; a bare number is in ms) within what RTC serves.
+inline std::chrono::nanoseconds parse_period(const std::string& text,
+                                             const char* what = "--period") {
+  try {
+    return io::parse_duration(text, what, io::BareUnit::milliseconds, rtc::kMinPeriod,
+                              rtc::kMaxPeriod);
+  } catch (const io::ParseError& e) {
+    throw BadArgument{fmt::format("{} (the range RTC serves)", e.what())};
+  }
 }
 
 /// --robot / --robot-file.

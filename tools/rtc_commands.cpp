@@ -41,16 +41,6 @@ std::chrono::nanoseconds to_ns(double seconds) {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(Seconds(seconds));
 }
 
-/// "1ms", "250us", "0.028s"; a bare number is in ms.
-std::chrono::nanoseconds parse_period(const std::string& text, const char* what = "--period") {
-  try {
-    return io::parse_duration(text, what, io::BareUnit::milliseconds, rtc::kMinPeriod,
-                              rtc::kMaxPeriod);
-  } catch (const io::ParseError& e) {
-    throw BadArgument{fmt::format("{} (the range RTC serves)", e.what())};
-  }
-}
-
 /// The longest a control program runs or waits: beyond it a number is a typo (11.6 days).
 constexpr double kMaxRunSeconds = 1e6;
 
