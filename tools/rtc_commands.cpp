@@ -488,7 +488,7 @@ int run_jointtest(const RtcArgs& a) {
   r.session->set_hangup_handler([](rtc::Session&) {});
   // main() installed the handlers at start: a signal during the start-up counts too.
   const std::uint32_t stops = 0;
-  const auto stopped = [stops] { return io::stop_count() != stops; };
+  const auto stopped = [] { return io::stop_count() != stops; };
   const auto start = [&] { r.session->control(f1, f2); };
   start();
 
