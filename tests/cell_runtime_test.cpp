@@ -1,7 +1,7 @@
 // The workcell at run time (cell::Cell) on cells/cvarl.json in simulated time: both robots
 // moving at once through the same motion API as one robot, the Microbo following a frame the
 // PUMA moves, two arms driven towards each other stopped before their capsules come within the
-// margin, and one robot's fault leaving the other working.
+// margin, and one robot's fault stopping the others (or, when asked, leaving them working).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "cell_helpers.hpp"
 #include "rccx/cell/cell.hpp"
 #include "rccx/hw/simulated_arm.hpp"
 #include "rccx/math/units.hpp"
@@ -18,41 +19,7 @@ using namespace rccx;
 using namespace std::chrono_literals;
 using namespace rccx::math::literals;
 
-namespace {
-
-const char* const kCvarl = RCCX_CVARL_CELL;
-
-/// Tool pointing down (a = -z of the world) at world point p.
-math::Transform down_at(const math::Vec3& p) {
-  return {math::Rot3::rot_x(math::kPi), p};
-}
-
-/// The equation T6 TOOL = BASE_INV(robot) WORLD_GOAL for a world pose.
-rccl::PositionPtr world_position(cell::Cell& c, const std::string& robot, const std::string& name,
-                                 const math::Transform& world_goal) {
-  const auto t6 = rccl::t6();
-  const auto tool = rccl::constant(robot + "_tool", c.model().find_robot(robot)->tool.value());
-  const auto goal = c.in_base_of(robot, rccl::constant(name, world_goal));
-  return rccl::Position::make(name, {t6, tool}, {goal}, tool);
-}
-
-/// A robot's tool point in the world for joints q.
-math::Vec3 tool_point(cell::Cell& c, const std::string& robot, const kin::JointVector& q) {
-  const cell::CellRobot& r = *c.model().find_robot(robot);
-  return (r.base * c.robot(robot).kinematics().forward(q) * r.tool.value()).p;
-}
-
-/// Where the board is: 50 mm above its top face.
-const math::Vec3 kAbove{0.0, 0.0, 0.1516};
-
-/// Every failure message of a robot, for assertion output.
-std::string failures_of(rccl::Manipulator& m) {
-  std::string s;
-  for (const rccl::MotionEvent& e : m.failures()) s += std::string(e.message()) + "; ";
-  return s;
-}
-
-}  // namespace
+using namespace rccx::cell_test;
 
 TEST(CellRuntime, BuildsEveryRobotOfTheCellFile) {
   const auto c = cell::Cell::load(kCvarl);
@@ -237,21 +204,56 @@ TEST(CellRuntime, TwoArmsDrivenTowardsEachOtherStopOutsideTheMargin) {
   EXPECT_EQ(microbo.waitfor(back.end(), 20s), rccl::WaitResult::reached) << failures_of(microbo);
 }
 
-TEST(CellRuntime, OneRobotsFaultLeavesTheOtherWorking) {
-  const auto c = cell::Cell::load(kCvarl);
-  c->start();
-  rccl::Manipulator& puma = c->robot("puma");
-  rccl::Manipulator& microbo = c->robot("microbo");
+namespace {
+
+/// Both arms moving; the PUMA's joint 1 stops answering 200 ms in. Returns the Microbo's motion.
+rccl::Motion fault_the_puma_while_both_move(cell::Cell& c, const math::Vec3& m1) {
+  rccl::Manipulator& puma = c.robot("puma");
+  rccl::Manipulator& microbo = c.robot("microbo");
   const math::Vec3 p1 = kAbove + math::Vec3{-0.05, 0.0, 0.0};
-  const math::Vec3 m1 = kAbove + math::Vec3{0.10, 0.0, 0.0};
   puma.set_velocity(0.05, 0.5);
   microbo.set_velocity(0.05, 0.5);
-  const rccl::Motion a = puma.move(world_position(*c, "puma", "P1", down_at(p1)));
-  const rccl::Motion b = microbo.move(world_position(*c, "microbo", "M1", down_at(m1)));
-  c->wait_for(200ms);
-  c->hardware("puma").arm->inject(hw::Fault::joint_not_answering, 1);
+  const rccl::Motion a = puma.move(world_position(c, "puma", "P1", down_at(p1)));
+  const rccl::Motion b = microbo.move(world_position(c, "microbo", "M1", down_at(m1)));
+  c.wait_for(200ms);
+  c.hardware("puma").arm->inject(hw::Fault::joint_not_answering, 1);
   EXPECT_EQ(puma.waitfor(a.end(), 5s), rccl::WaitResult::session_ended) << failures_of(puma);
-  EXPECT_EQ(c->session("puma").termination().code, rtc::TerminateCode::joint_not_answering);
+  EXPECT_EQ(c.session("puma").termination().code, rtc::TerminateCode::joint_not_answering);
+  return b;
+}
+
+}  // namespace
+
+TEST(CellRuntime, OneRobotsFaultStopsTheOthersWhichHoldAndMayMoveAgain) {
+  const auto c = cell::Cell::load(kCvarl);
+  c->start();
+  rccl::Manipulator& microbo = c->robot("microbo");
+  const math::Vec3 m1 = kAbove + math::Vec3{0.10, 0.0, 0.0};
+  const rccl::Motion b = fault_the_puma_while_both_move(*c, m1);
+  EXPECT_EQ(microbo.waitfor(b.end(), 20s), rccl::WaitResult::failed);
+  ASSERT_FALSE(microbo.failures().empty());
+  const std::string why(microbo.failures().front().message());
+  EXPECT_NE(why.find("puma's control ended (joint_not_answering"), std::string::npos) << why;
+  // It holds, still under control: the joints stay where the stop left them.
+  c->wait_for(300ms);
+  EXPECT_TRUE(c->session("microbo").controlling());
+  const kin::JointVector held = c->session("microbo").how().q();
+  c->wait_for(1s);
+  const kin::JointVector later = c->session("microbo").how().q();
+  for (std::size_t j = 0; j < held.size(); ++j) EXPECT_NEAR(later[j], held[j], 1e-3) << j;
+  // And the program may move it again.
+  const rccl::Motion b2 = microbo.move(world_position(*c, "microbo", "M1b", down_at(m1)));
+  EXPECT_EQ(microbo.waitfor(b2.end(), 20s), rccl::WaitResult::reached) << failures_of(microbo);
+}
+
+TEST(CellRuntime, WithoutStopOnFaultTheOthersGoOn) {
+  cell::CellOptions o;
+  o.stop_others_on_fault = false;
+  const auto c = cell::Cell::load(kCvarl, o);
+  c->start();
+  rccl::Manipulator& microbo = c->robot("microbo");
+  const math::Vec3 m1 = kAbove + math::Vec3{0.10, 0.0, 0.0};
+  const rccl::Motion b = fault_the_puma_while_both_move(*c, m1);
   ASSERT_EQ(microbo.waitfor(b.end(), 20s), rccl::WaitResult::reached) << failures_of(microbo);
   EXPECT_TRUE(c->session("microbo").controlling());
   c->wait_for(500ms);

@@ -86,6 +86,8 @@ Cell::Cell(CellModel model, CellOptions options)
     r->hardware = rtc::make_simulated_hardware(cr.model, true, options_.ideal_servo);
     r->session = &group_->add(*r->hardware.driver, static_cast<int>(cr.period_multiple));
     r->manipulator = std::make_unique<rccl::Manipulator>(*r->session);
+    r->manipulator->generator().set_robot_name(cr.name);
+    r->ledger.set_robot(cr.name);
     r->base_inverse = cr.base.inverse();
     r->tool = cr.tool.value_or(math::Transform::identity());
     r->period_s = std::chrono::duration<double>(model_.period(i)).count();
@@ -143,6 +145,121 @@ void Cell::start() {
 
 void Cell::wait_for(std::chrono::nanoseconds d) {
   group_->wait_for(d);
+}
+
+// --- Synchronisation -----------------------------------------------------------------------------
+
+rccl::EventGate Cell::event(std::string_view robot, const rccl::Event& e) {
+  Robot& r = find(robot);
+  rccl::EventGate g = r.manipulator->gate(e);  // resolves completed() to a motion id
+  g.ledger = &r.ledger;
+  return g;
+}
+
+Together Cell::together(const std::vector<std::string>& robots, bool end_together) {
+  if (robots.empty() || robots.size() > rccl::Rendezvous::kMaxParticipants) {
+    throw std::invalid_argument(fmt::format("a joint start takes 1 to {} robots (got {})",
+                                            rccl::Rendezvous::kMaxParticipants, robots.size()));
+  }
+  std::vector<const rccl::MotionLedger*> ledgers;
+  for (const std::string& name : robots) {
+    const Robot& r = find(name);
+    if (std::find(ledgers.begin(), ledgers.end(), &r.ledger) != ledgers.end()) {
+      throw std::invalid_argument(fmt::format("robot {} is named twice in a joint start", name));
+    }
+    ledgers.push_back(&r.ledger);
+  }
+  return {std::make_shared<rccl::Rendezvous>(robots.size(), end_together, std::move(ledgers)),
+          robots};
+}
+
+rccl::StartWhen Together::when(std::string_view robot, std::vector<rccl::EventGate> after) const {
+  const auto it = std::find(robots.begin(), robots.end(), robot);
+  if (it == robots.end()) {
+    throw std::invalid_argument(fmt::format("robot {} does not take part in this joint start ({})",
+                                            robot, fmt::join(robots, ", ")));
+  }
+  rccl::StartWhen w;
+  w.after = std::move(after);
+  w.together = rendezvous;
+  w.slot = static_cast<std::size_t>(it - robots.begin());
+  return w;
+}
+
+rccl::WaitResult Cell::waitfor(const std::vector<rccl::EventGate>& gates,
+                               std::chrono::nanoseconds timeout) {
+  const auto answer = [&] {
+    bool all = true;
+    for (const rccl::EventGate& g : gates) {
+      const rccl::GateAnswer a = g.answer();
+      if (a == rccl::GateAnswer::never) return rccl::GateAnswer::never;
+      all = all && a == rccl::GateAnswer::yes;
+    }
+    return all ? rccl::GateAnswer::yes : rccl::GateAnswer::not_yet;
+  };
+  const auto deadline = std::chrono::steady_clock::now() + timeout;  // real time
+  std::chrono::nanoseconds left = timeout;
+  for (;;) {
+    if (const rccl::GateAnswer a = answer(); a != rccl::GateAnswer::not_yet) {
+      return a == rccl::GateAnswer::yes ? rccl::WaitResult::reached : rccl::WaitResult::failed;
+    }
+    // Any robot under control carries the cell's clock; another one once it ends.
+    rtc::Session* carrier = nullptr;
+    for (auto& r : robots_) {
+      if (r->session->controlling()) {
+        carrier = r->session;
+        break;
+      }
+    }
+    if (carrier == nullptr) return rccl::WaitResult::session_ended;
+    const auto t0 = std::chrono::duration<double>(carrier->how().time_s);
+    const bool done = carrier->wait_until(
+        [&](const rtc::How&) { return answer() != rccl::GateAnswer::not_yet; }, left);
+    if (done) continue;
+    if (carrier->controlling()) return rccl::WaitResult::timeout;
+    // Its control ended: take off the time spent (simulated: the cell's) and go on.
+    const auto spent = std::chrono::duration_cast<std::chrono::nanoseconds>(
+        std::chrono::duration<double>(carrier->how().time_s) - t0);
+    left -= std::max(spent, std::chrono::nanoseconds(0));
+    if (options_.clock == rtc::ClockKind::real_time) {
+      left = std::chrono::duration_cast<std::chrono::nanoseconds>(deadline -
+                                                                  std::chrono::steady_clock::now());
+    }
+    if (left <= std::chrono::nanoseconds(0)) return rccl::WaitResult::timeout;
+  }
+}
+
+void Cell::publish_ledgers() noexcept {
+  for (auto& rp : robots_) {
+    Robot& r = *rp;
+    r.ledger.copy_from(r.manipulator->generator().ledger());
+    const bool controlling = r.session->controlling();
+    if (controlling) {
+      r.was_controlling = true;
+      if (r.ledger.control_ended()) r.ledger.set_control_ended(false);
+      continue;
+    }
+    if (!r.was_controlling) continue;
+    r.was_controlling = false;
+    r.ledger.set_control_ended(true);
+    const rtc::TerminateCode code = r.session->ended_code();
+    if (!options_.stop_others_on_fault || code == rtc::TerminateCode::none ||
+        code == rtc::TerminateCode::user_request || code == rtc::TerminateCode::user_interrupt) {
+      continue;
+    }
+    try {
+      const auto out = fmt::format_to_n(message_.data(), message_.size() - 1,
+                                        "stopped: {}'s control ended ({}: {}); the cell holds "
+                                        "every arm",
+                                        r.name, rtc::to_string(code), rtc::describe(code));
+      *out.out = '\0';
+    } catch (...) {  // fmt allocates nothing here; the stop matters more than its words
+      message_[0] = '\0';
+    }
+    for (auto& other : robots_) {
+      if (other.get() != &r) other->manipulator->generator().request_stop(message_.data());
+    }
+  }
 }
 
 const Cell::Robot& Cell::find(std::string_view name) const {
@@ -270,6 +387,7 @@ void Cell::on_cycle(std::uint32_t tick) noexcept {
     r.valid = true;
   }
   if (options_.collision_checks) check_collisions();
+  publish_ledgers();
   if (observer_) observer_(tick);
 }
 

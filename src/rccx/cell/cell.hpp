@@ -59,6 +59,20 @@ struct CellOptions {
   /// Every robot on an ideal servo (hw::IdealArm) instead of its plant (the PUMA's PID on
   /// its dynamics, the Microbo's RCU): for load tests of the cycle itself.
   bool ideal_servo = false;
+  /// When a robot's control ends by a fault (any terminate code but user_request and
+  /// user_interrupt), every other robot stops smoothly and holds, its motion failed with the
+  /// reason; false: the others go on (their motions that wait on it are cancelled still).
+  bool stop_others_on_fault = true;
+};
+
+/// Motions of several robots that start in the same sample (Cell::together).
+struct Together {
+  std::shared_ptr<rccl::Rendezvous> rendezvous;
+  std::vector<std::string> robots;
+  /// What `robot`'s motion of this joint start passes to move() / dwell(), with events it also
+  /// waits for. Throws std::invalid_argument for a robot not taking part.
+  [[nodiscard]] rccl::StartWhen when(std::string_view robot,
+                                     std::vector<rccl::EventGate> after = {}) const;
 };
 
 /// A robot's commanded tool frame in the world at one instant, as the control task publishes it.
@@ -116,6 +130,26 @@ class Cell {
   /// The last published tool frame of a robot (any thread).
   [[nodiscard]] ToolSample tool_sample(std::string_view name) const;
 
+  // --- Synchronisation (Multi-RCCL) ----------------------------------------------------------
+  /// An event of `robot`'s motions, for another robot's motion to wait for (StartWhen::after,
+  /// Together::when) or the program (waitfor). Read from a copy the control task makes after
+  /// every tick: a motion waiting on it starts at its first sample after the tick the event
+  /// happened in, whatever the robots' order. Event::completed() means the last motion `robot`
+  /// has queued so far. Throws like robot(); rccl::MotionError for a position's end.
+  [[nodiscard]] rccl::EventGate event(std::string_view robot, const rccl::Event& e);
+  /// A joint start: one motion of each of `robots` (each queued with Together::when) starts in
+  /// the same sample, the first all of them are sampled in once every one is at rest and
+  /// ready; with `end_together`, all end (come to rest) in the same sample too, the faster
+  /// motions slowed to the slowest. A participant's motion that fails or is cancelled before
+  /// the start, or its robot's control ending, cancels the others' with the reason. One use.
+  [[nodiscard]] Together together(const std::vector<std::string>& robots,
+                                  bool end_together = false);
+  /// Waits for every gate (in simulated time: runs the cell's ticks until then). reached;
+  /// failed when a gate can no longer open (its motion failed or was cancelled, its robot's
+  /// control ended); timeout; session_ended when no robot's control is running.
+  rccl::WaitResult waitfor(const std::vector<rccl::EventGate>& gates,
+                           std::chrono::nanoseconds timeout = std::chrono::hours(24));
+
   // --- Sample loop -----------------------------------------------------------------------------
   /// A function the control task runs after each tick's collision check (tests, monitors).
   /// Before start() only; it must not block. Inside it, collision_world() holds every robot's
@@ -158,13 +192,16 @@ class Cell {
     double last_t_s = -1.0;  ///< the setpoint time last published
     bool valid = false;      ///< has a setpoint in the collision world
     double braking_m = 0.0;
-    math::Vec3 velocity_back;  ///< the tool point's last backward difference, m/s
+    math::Vec3 velocity_back;   ///< the tool point's last backward difference, m/s
+    rccl::MotionLedger ledger;  ///< the generator's, as of the end of the last tick
+    bool was_controlling = false;
   };
 
   [[nodiscard]] const Robot& find(std::string_view name) const;
   [[nodiscard]] Robot& find(std::string_view name);
   void on_cycle(std::uint32_t tick) noexcept;
   void check_collisions() noexcept;
+  void publish_ledgers() noexcept;
 
   CellModel model_;
   CellOptions options_;

@@ -41,7 +41,9 @@ Manipulator::Manipulator(rtc::Session& session)
       kinematics_(kin::make_kinematics(session.driver().model())),
       generator_(std::make_unique<TrajectoryGenerator>(*kinematics_, generator_options(session))),
       lower_(kinematics_->model().lower()),
-      park_(Position::joints("park", kinematics_->model().ready())) {}
+      park_(Position::joints("park", kinematics_->model().ready())) {
+  generator_->set_robot_name(kinematics_->model().name);
+}
 
 Manipulator::~Manipulator() {
   if (started_) {
@@ -170,11 +172,42 @@ void Manipulator::check_reachable(const Position& p) const {
   }
 }
 
-Motion Manipulator::submit(MotionRequest r, const PositionPtr& keep) {
+Motion Manipulator::submit(MotionRequest r, const PositionPtr& keep, const StartWhen& when) {
   if (!started_) throw MotionError("call start() (rccl_control) before queuing motions");
   if (zero_gravity_) throw MotionError("zero gravity is on: set_zero_gravity(false) first");
   r.id = next_id_;
   r.settings = settings_;
+  if (when.after.size() > StartWhen::kMaxGates) {
+    throw MotionError(
+        fmt::format("a motion waits for at most {} events (got {}); wait for the "
+                    "others in the program first (Cell::waitfor)",
+                    StartWhen::kMaxGates, when.after.size()));
+  }
+  for (const EventGate& g : when.after) {
+    if (g.ledger == nullptr) throw MotionError("a start condition has no robot (a null gate)");
+    if (g.ledger == &generator_->ledger() && g.id >= r.id) {
+      throw MotionError(
+          fmt::format("motion {} of {} would wait for its own motion {}, which "
+                      "cannot start before it",
+                      r.id, g.ledger->robot(), g.id));
+    }
+    r.after[r.gates++] = g;
+  }
+  if (when.together) {
+    if (when.slot >= when.together->participants()) {
+      throw MotionError(fmt::format("rendezvous slot {} of {} participants", when.slot,
+                                    when.together->participants()));
+    }
+    if (when.together->start_s() >= 0.0 || !when.together->withdrawn().empty()) {
+      throw MotionError("this rendezvous has been used (or broken) already: make a new one");
+    }
+    r.together = when.together.get();
+    r.slot = static_cast<std::uint8_t>(when.slot);
+    if (std::find(keep_rendezvous_.begin(), keep_rendezvous_.end(), when.together) ==
+        keep_rendezvous_.end()) {
+      keep_rendezvous_.push_back(when.together);
+    }
+  }
   if (keep && std::find(keep_.begin(), keep_.end(), keep) == keep_.end()) keep_.push_back(keep);
   if (keep) keep->pending_ends.fetch_add(1, std::memory_order_acq_rel);
   if (!generator_->submit(r)) {
@@ -186,23 +219,23 @@ Motion Manipulator::submit(MotionRequest r, const PositionPtr& keep) {
   return {r.id};
 }
 
-Motion Manipulator::move(const PositionPtr& position) {
+Motion Manipulator::move(const PositionPtr& position, const StartWhen& when) {
   if (!position) throw MotionError("move(): the position is null");
   check_reachable(*position);
   MotionRequest r;
   r.kind = RequestKind::move;
   r.position = position.get();
-  return submit(r, position);
+  return submit(r, position, when);
 }
 
-Motion Manipulator::dwell(double seconds) {
+Motion Manipulator::dwell(double seconds, const StartWhen& when) {
   if (!(seconds >= 0.0) || !std::isfinite(seconds)) {
     throw MotionError(fmt::format("dwell time must be >= 0 s, got {}", seconds));
   }
   MotionRequest r;
   r.kind = RequestKind::dwell;
   r.dwell_s = seconds;
-  return submit(r, nullptr);
+  return submit(r, nullptr, when);
 }
 
 void Manipulator::set_zero_gravity(bool on) {
@@ -235,6 +268,29 @@ bool Manipulator::happened(const Event& e) const noexcept {
       return generator_->ended_upto() >= next_id_ - 1;
   }
   return false;
+}
+
+EventGate Manipulator::gate(const Event& event) const {
+  EventGate g;
+  g.ledger = &generator_->ledger();
+  switch (event.kind) {
+    case Event::Kind::motion_start:
+      g.kind = EventGate::Kind::started;
+      g.id = event.id;
+      break;
+    case Event::Kind::motion_end:
+      g.kind = EventGate::Kind::ended;
+      g.id = event.id;
+      break;
+    case Event::Kind::completed:
+      g.kind = EventGate::Kind::ended;
+      g.id = next_id_ - 1;
+      break;
+    case Event::Kind::position_end:
+      throw MotionError(
+          "another robot cannot wait for a position's end: wait for the motion's end instead");
+  }
+  return g;
 }
 
 WaitResult Manipulator::waitfor(const Event& event, std::chrono::nanoseconds timeout) {

@@ -89,10 +89,13 @@ class Manipulator {
   // --- Motions ----------------------------------------------------------------------------------
   /// Queues a motion to `position` and returns at once. A position whose transforms are all
   /// constant or hold is checked now: throws MotionError (queuing nothing) when no
-  /// configuration reaches it within limits.
-  Motion move(const PositionPtr& position);
-  /// RCCL's stop(): stay where the previous motion ends for `seconds`.
-  Motion dwell(double seconds);
+  /// configuration reaches it within limits. `when`: the motion starts only once those events
+  /// (other robots' motions, see cell::Cell::event) have happened, or with the others of a
+  /// rendezvous; it then starts from rest (the motion before it comes to rest first unless
+  /// its gates are open by then) and is cancelled with the reason when a gate cannot open.
+  Motion move(const PositionPtr& position, const StartWhen& when = {});
+  /// RCCL's stop(): stay where the previous motion ends for `seconds` (gated as move()).
+  Motion dwell(double seconds, const StartWhen& when = {});
   /// Stops smoothly where the arm is and cancels everything queued.
   void halt();
   /// Zero gravity ("marsh"): on, the generator stops commanding and the joints follow a push
@@ -118,6 +121,12 @@ class Manipulator {
                      std::chrono::nanoseconds timeout = std::chrono::hours(24 * 365));
   /// True when `event` has happened.
   [[nodiscard]] bool happened(const Event& event) const noexcept;
+  /// An event of this arm as another arm's motion may wait for it (StartWhen::after), read
+  /// from the generator as it runs: a motion of another robot stepped later in the same tick
+  /// sees it in that tick. (A cell's Cell::event reads a copy made after each tick instead, so
+  /// the order of the robots does not matter.) motion_start, motion_end and completed (the
+  /// last motion queued so far); throws MotionError for position_end.
+  [[nodiscard]] EventGate gate(const Event& event) const;
 
   // --- What happened ----------------------------------------------------------------------------
   /// Failures and cancellations so far (collected from the generator's events).
@@ -135,7 +144,7 @@ class Manipulator {
   [[nodiscard]] TrajectoryGenerator& generator() noexcept { return *generator_; }
 
  private:
-  Motion submit(MotionRequest r, const PositionPtr& keep);
+  Motion submit(MotionRequest r, const PositionPtr& keep, const StartWhen& when);
   void drain();
   void check_reachable(const Position& p) const;
 
@@ -146,6 +155,7 @@ class Manipulator {
   MotionSettings settings_;
   PositionPtr park_;
   std::vector<PositionPtr> keep_;  ///< positions the loop may still point to
+  std::vector<std::shared_ptr<Rendezvous>> keep_rendezvous_;  ///< likewise
   std::uint64_t next_id_ = 1;
   bool started_ = false;
   bool first_sample_ = true;   ///< loop side: reset the generator at the arm's position

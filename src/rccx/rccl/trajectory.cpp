@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "rccx/rccl/paul_transition.hpp"
+#include "rccx/rtc/types.hpp"
 
 namespace rccx::rccl {
 namespace {
@@ -526,7 +527,7 @@ void TrajectoryGenerator::begin_transition(const SampleContext& ctx, double tB, 
   have_last_frame_ = false;
   if (to_next) {
     next_.tau_in = tau;
-    started_.store(next_.id, std::memory_order_release);
+    ledger_.mark_started(next_.id);
     emit(EventKind::started, next_.id, ctx);
     SegmentReport& rep = reports_[next_.id % kReports];
     rep = SegmentReport{};
@@ -666,7 +667,7 @@ void TrajectoryGenerator::end_motion(const Segment& s, const SampleContext& ctx)
   if (rep.id == s.id) rep.end_s = ctx.t_s;
   if (s.position != nullptr) s.position->pending_ends.fetch_sub(1, std::memory_order_acq_rel);
   emit(EventKind::ended, s.id, ctx);
-  ended_.store(s.id, std::memory_order_release);
+  ledger_.mark_ended(s.id);
 }
 
 void TrajectoryGenerator::fail(std::uint64_t id, const SampleContext& ctx, kin::IkStatus status,
@@ -691,6 +692,7 @@ void TrajectoryGenerator::fail(std::uint64_t id, const SampleContext& ctx, kin::
     w.id = waiting_->id;
     w.position = waiting_->position;
     cancel(w);
+    withdraw_from(*waiting_, text);
     waiting_.reset();
   }
   MotionRequest r;
@@ -699,11 +701,11 @@ void TrajectoryGenerator::fail(std::uint64_t id, const SampleContext& ctx, kin::
     w.id = r.id;
     w.position = r.position;
     cancel(w);
+    withdraw_from(r, text);
   }
   has_next_ = false;
   tr_.active = false;
-  started_.store(std::max(started_.load(), last), std::memory_order_release);
-  ended_.store(last, std::memory_order_release);
+  ledger_.mark_failed(id, last);
   start_halt();
 }
 
@@ -760,8 +762,86 @@ void TrajectoryGenerator::rest_at(const JointVector& q) noexcept {
   pose_valid_ = false;
 }
 
-void TrajectoryGenerator::reset(const JointVector& q, double t_s) noexcept {
+// --- Gates and rendezvous
+// -------------------------------------------------------------------------
+
+TrajectoryGenerator::GateState TrajectoryGenerator::gate_state(Text& why) const noexcept {
+  const MotionRequest& r = *waiting_;
+  for (std::size_t k = 0; k < r.gates; ++k) {
+    const EventGate& g = r.after[k];
+    const GateAnswer a = g.answer();
+    if (a == GateAnswer::yes) continue;
+    if (a == GateAnswer::not_yet) return GateState::closed;
+    const std::string_view robot = g.ledger != nullptr ? g.ledger->robot() : "?";
+    const char* what = g.kind == EventGate::Kind::started ? "start" : "end";
+    if (g.ledger != nullptr && g.ledger->control_ended() && !g.ledger->failed(g.id)) {
+      why = text("cancelled: it waited for the {} of {}'s motion {}, and {}'s control ended", what,
+                 robot, g.id, robot);
+    } else {
+      why = text("cancelled: it waited for the {} of {}'s motion {}, which failed or was cancelled",
+                 what, robot, g.id);
+    }
+    return GateState::cancel;
+  }
+  if (r.together != nullptr) {
+    if (const std::string_view w = r.together->withdrawn(); !w.empty()) {
+      why = text("cancelled: its joint start cannot happen: {}", w);
+      return GateState::cancel;
+    }
+    if (const MotionLedger* lost = r.together->lost_participant(); lost != nullptr) {
+      why = text("cancelled: its joint start cannot happen: {}'s control ended", lost->robot());
+      return GateState::cancel;
+    }
+  }
+  return GateState::open;
+}
+
+void TrajectoryGenerator::start_waiting(const SampleContext& ctx, double t) {
+  Rendezvous* rv = waiting_->together;
+  const double eps = 1e-9;
+  // Samples are for the tick's time (How); the setpoint time runs the pipeline ahead of it.
+  const double now = ctx.how != nullptr ? ctx.how->time_s : t;
+  if (rv != nullptr && !(rv->start_s() >= 0.0 && now >= rv->start_s() - eps)) {
+    if (rendezvous_ready_ || rv->start_s() >= 0.0) return;  // waiting for the others' or the start
+    // Plan as if starting now, to tell the others how long this motion takes; build again at
+    // the start (a goal may move meanwhile).
+    const MotionRequest r = *waiting_;
+    if (!build(r, ctx, t)) return;  // failed: fail() withdrew it
+    const Blend blend = blend_between(cur_, &next_);
+    const double tau = transition_tau(cur_, next_, blend, t, ctx);
+    has_next_ = false;
+    rendezvous_ready_ = true;
+    rv->ready(r.slot, now, tau + next_.T + next_.stop_tau, options_.period_s);
+    return;
+  }
+  const MotionRequest r = *waiting_;
+  // From rest: the transition begins now; the straight part tau later.
+  if (!build(r, ctx, t)) return;
   waiting_.reset();
+  rendezvous_ready_ = false;
+  const Blend blend = blend_between(cur_, &next_);
+  const double tau = transition_tau(cur_, next_, blend, t, ctx);
+  if (rv != nullptr && rv->end_together()) {
+    // Slowed to the slowest: the straight part takes the time left between both transitions
+    // (planned for the faster motion, so they stay within the bounds for the slower one).
+    next_.T = std::max(next_.T, rv->duration_s() - tau - next_.stop_tau);
+  }
+  next_.ts = t + tau;
+  begin_transition(ctx, t + tau, tau, blend, true);
+}
+
+void TrajectoryGenerator::withdraw_from(const MotionRequest& r, const Text& why) noexcept {
+  if (r.together == nullptr) return;
+  r.together->withdraw(
+      r.slot,
+      std::string_view(
+          text("{}'s motion {} ended before it: {}", ledger_.robot(), r.id, why.data()).data()));
+}
+
+void TrajectoryGenerator::reset(const JointVector& q, double t_s) noexcept {
+  if (waiting_) withdraw_from(*waiting_, text("its robot's control started again"));
+  waiting_.reset();
+  rendezvous_ready_ = false;
   has_next_ = false;
   tr_ = Transition{};
   halt_ = Halt{};
@@ -802,23 +882,34 @@ std::uint64_t TrajectoryGenerator::step(const SampleContext& ctx, const JointVec
   }
   if (!waiting_) {
     MotionRequest r;
-    if (requests_.pop(r)) waiting_ = r;
+    if (requests_.pop(r)) {
+      waiting_ = r;
+      rendezvous_ready_ = false;
+    }
   }
 
   if (!halt_.active && !tr_.active) {
     const bool resting = cur_.kind == Segment::Kind::rest || cur_.resting;
     if (resting && waiting_) {
-      // From rest: the transition begins now; the straight part tau later.
-      if (build(*waiting_, ctx, t)) {
-        waiting_.reset();
-        const Blend blend = blend_between(cur_, &next_);
-        const double tau = transition_tau(cur_, next_, blend, t, ctx);
-        next_.ts = t + tau;
-        begin_transition(ctx, t + tau, tau, blend, true);
+      Text why{};
+      switch (gate_state(why)) {
+        case GateState::open:
+          start_waiting(ctx, t);
+          break;
+        case GateState::cancel:
+          fail(waiting_->id, ctx, kin::IkStatus::ok, 0, why);
+          break;
+        case GateState::closed:
+          break;
       }
     } else if (!resting) {
       const double te = cur_.ts + cur_.T;
-      if (!has_next_ && waiting_ && t < te - cur_.stop_tau - eps) {
+      // A gated motion joins its predecessor only when it may start already; one with a
+      // rendezvous always starts from rest, where the others can wait for it.
+      Text why{};
+      const bool may_join = waiting_ && waiting_->together == nullptr &&
+                            (waiting_->gates == 0 || gate_state(why) == GateState::open);
+      if (!has_next_ && may_join && t < te - cur_.stop_tau - eps) {
         if (build(*waiting_, ctx, te)) {
           waiting_.reset();
           const Blend blend = blend_between(cur_, &next_);

@@ -38,6 +38,7 @@
 
 #include "rccx/kinematics/kinematics.hpp"
 #include "rccx/rccl/position.hpp"
+#include "rccx/rccl/sync.hpp"
 
 namespace rccx::rccl {
 
@@ -65,6 +66,14 @@ struct MotionRequest {
   const Position* position = nullptr;  ///< move: kept alive by the planning level
   MotionSettings settings;
   double dwell_s = 0.0;  ///< dwell: how long to stay
+  /// Start only once these events have happened (gates[0 .. gates)); a gate that can no longer
+  /// open cancels the motion (and those after it) with the reason.
+  std::array<EventGate, StartWhen::kMaxGates> after{};
+  std::uint8_t gates = 0;
+  /// Start with the other participants of this rendezvous (kept alive by the planning level).
+  Rendezvous* together = nullptr;
+  std::uint8_t slot = 0;
+  [[nodiscard]] bool gated() const noexcept { return gates > 0 || together != nullptr; }
 };
 
 enum class EventKind : std::uint8_t { started, ended, failed, cancelled };
@@ -137,8 +146,12 @@ class TrajectoryGenerator {
   /// Asks the loop to stop smoothly where it is and cancel everything queued.
   void request_halt() noexcept { halt_requested_.store(true, std::memory_order_release); }
   /// Highest id started / ended (ended includes failed and cancelled), in queue order.
-  [[nodiscard]] std::uint64_t started_upto() const noexcept { return started_.load(); }
-  [[nodiscard]] std::uint64_t ended_upto() const noexcept { return ended_.load(); }
+  [[nodiscard]] std::uint64_t started_upto() const noexcept { return ledger_.started_upto(); }
+  [[nodiscard]] std::uint64_t ended_upto() const noexcept { return ledger_.ended_upto(); }
+  /// The same, with the failures, for other robots' motions to wait on (sync.hpp).
+  [[nodiscard]] const MotionLedger& ledger() const noexcept { return ledger_; }
+  /// The robot's name in messages about gates; before the loop runs.
+  void set_robot_name(std::string_view name) noexcept { ledger_.set_robot(name); }
   /// The report of motion `id`, once ended_upto() >= id (and fewer than kReports later).
   [[nodiscard]] SegmentReport report(std::uint64_t id) const noexcept;
 
@@ -221,6 +234,14 @@ class TrajectoryGenerator {
   [[nodiscard]] Segment rest_of(const Segment& a) const noexcept;
 
   bool build(const MotionRequest& r, const SampleContext& ctx, double t_via);
+  enum class GateState : std::uint8_t { open, closed, cancel };
+  /// Whether waiting_'s gates let it start now (its rendezvous apart); cancel: why says why.
+  GateState gate_state(Text& why) const noexcept;
+  /// From rest: builds waiting_ and begins its transition in at t (through its rendezvous,
+  /// when it has one).
+  void start_waiting(const SampleContext& ctx, double t);
+  /// Cancels the requests from `id` on with `why`, withdrawing them from their rendezvous.
+  void withdraw_from(const MotionRequest& r, const Text& why) noexcept;
   /// The 1-based joint whose solution jumps between drive fractions r0 and r1 of Cartesian
   /// segment s (solved as q0, q1): a singularity on the line. 0: none.
   [[nodiscard]] int find_jump(const Segment& s, const SampleContext& ctx, double r0, double r1,
@@ -267,7 +288,7 @@ class TrajectoryGenerator {
   std::atomic<bool> halt_requested_{false};
   bool stop_requested_ = false;  ///< request_stop(): same thread as step()
   Text stop_text_{};
-  std::atomic<std::uint64_t> started_{0}, ended_{0};
+  MotionLedger ledger_;
   std::array<SegmentReport, kReports> reports_{};
 
   // Loop state.
@@ -275,6 +296,7 @@ class TrajectoryGenerator {
   bool has_next_ = false;
   double next_tau_ = 0.0;                 ///< half the transition from cur_ into next_, s
   std::optional<MotionRequest> waiting_;  ///< taken from the queue, not yet built
+  bool rendezvous_ready_ = false;         ///< waiting_ has told its rendezvous it is ready
   Transition tr_;
   Halt halt_;
   kin::JointVector last_q_, prev_q_;  ///< the last two setpoints

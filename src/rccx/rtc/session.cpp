@@ -468,6 +468,12 @@ bool Session::controlling() const noexcept {
   return shared_->phase.load(std::memory_order_acquire) == kControlling;
 }
 
+TerminateCode Session::ended_code() const noexcept {
+  // The termination is written while kEnding and not again until the next control().
+  if (shared_->phase.load(std::memory_order_acquire) != kEnded) return TerminateCode::none;
+  return shared_->termination.code;
+}
+
 void Session::wait_control_idle() const {
   const Clock& clk = *clock_;
   while (clk.control_busy.load(std::memory_order_seq_cst)) {

@@ -142,6 +142,9 @@ class Session {
   [[nodiscard]] bool controlling() const noexcept;
   /// The termination of the present or last control session (code none while it runs).
   [[nodiscard]] Termination termination() const;
+  /// The terminate code once control has ended, else none: lock-free, for the sample loop (a
+  /// cell's checks between robots).
+  [[nodiscard]] TerminateCode ended_code() const noexcept;
   /// This robot's sample period: the clock's period times its multiple (see SessionGroup).
   [[nodiscard]] std::chrono::nanoseconds period() const noexcept;
   /// Changes the sample period; only while control is not active, and not in a group.

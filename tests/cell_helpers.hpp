@@ -1,0 +1,45 @@
+// What the workcell's tests share: positions in the world of cells/cvarl.json for one of its
+// robots, a robot's tool point, its failures as text.
+#pragma once
+
+#include <string>
+
+#include "rccx/cell/cell.hpp"
+#include "rccx/math/units.hpp"
+
+namespace rccx::cell_test {
+
+inline const char* const kCvarl = RCCX_CVARL_CELL;
+
+/// Tool pointing down (a = -z of the world) at world point p.
+inline math::Transform down_at(const math::Vec3& p) {
+  return {math::Rot3::rot_x(math::kPi), p};
+}
+
+/// The equation T6 TOOL = BASE_INV(robot) WORLD_GOAL for a world pose.
+inline rccl::PositionPtr world_position(cell::Cell& c, const std::string& robot,
+                                        const std::string& name,
+                                        const math::Transform& world_goal) {
+  const auto t6 = rccl::t6();
+  const auto tool = rccl::constant(robot + "_tool", c.model().find_robot(robot)->tool.value());
+  const auto goal = c.in_base_of(robot, rccl::constant(name, world_goal));
+  return rccl::Position::make(name, {t6, tool}, {goal}, tool);
+}
+
+/// A robot's tool point in the world for joints q.
+inline math::Vec3 tool_point(cell::Cell& c, const std::string& robot, const kin::JointVector& q) {
+  const cell::CellRobot& r = *c.model().find_robot(robot);
+  return (r.base * c.robot(robot).kinematics().forward(q) * r.tool.value()).p;
+}
+
+/// Where the board is: 50 mm above its top face.
+inline const math::Vec3 kAbove{0.0, 0.0, 0.1516};
+
+/// Every failure message of a robot, for assertion output.
+inline std::string failures_of(rccl::Manipulator& m) {
+  std::string s;
+  for (const rccl::MotionEvent& e : m.failures()) s += std::string(e.message()) + "; ";
+  return s;
+}
+
+}  // namespace rccx::cell_test
