@@ -201,6 +201,107 @@ int rccl_wait_sample(void);
     }                                     \
   } while (0)
 
+
+/* --- Several robots: a workcell (Multi-RCCL style) ------------------------------------------- */
+/*
+ * A program may drive all the robots of a cell file (cells/ *.json: robots placed in a world
+ * frame) instead of one: rccl_cell_open() instead of rccl_open(), a MANIP handle per robot
+ * (Multi-RCCL's rcclCreate), the mnp_ calls with the handle first where the one-robot calls have
+ * none, and rcclStart / rcclRelease for rccl_control / rccl_close. Transforms, makeposition,
+ * POS.end and waitfor() are shared: waitfor() lets one tick of the cell's clock run. The
+ * one-robot calls (move, setvel, ...) are refused while a cell is open (RTC_E_SEQUENCE).
+ *
+ *   rccl_cell_open("cells/cvarl.json");
+ *   MANIP *puma = rcclCreate("puma", 0), *mbo = rcclCreate("microbo", 0);
+ *   rcclStart();
+ *   p = makeposition("P", t6, mnp_tool(puma), EQ, mnp_base_inv(puma), goal, TL, mnp_tool(puma));
+ *   mnp_move(puma, p);  a = mnp_last_motion(puma);
+ *   mnp_after(mbo, puma, a, RCCL_END);  mnp_move(mbo, q);   the Microbo starts when P is reached
+ *   waitfor(mnp_completed(mbo));
+ *   rcclRelease(0);
+ */
+
+/** A robot of the open cell (opaque). */
+typedef struct rccl_manip MANIP;
+
+/** The events of another robot's motion that mnp_after() waits for. */
+#define RCCL_START 1
+#define RCCL_END 2
+
+/**
+ * Opens the cell described by `cell_file` (NULL: the environment variable RCCX_CELL, else the
+ * shipped cells/cvarl.json), its robots simulated in simulated time. Returns 0, or an error
+ * code (RTC_E_SEQUENCE: a session or cell is open; RTC_E_ROBOT: a bad cell file, the message
+ * says where).
+ */
+int rccl_cell_open(const char* cell_file);
+
+/**
+ * The robot `name` of the open cell (Multi-RCCL's rcclCreate; `flags` reserved, pass 0). The
+ * same handle for the same name. NULL on error (RTC_E_SEQUENCE without a cell, RTC_E_ROBOT
+ * for a name the cell does not have: the message lists them).
+ */
+MANIP* rcclCreate(const char* name, int flags);
+
+/** Starts every robot's trajectory generator (rccl_control for the cell). 0 or an error. */
+int rcclStart(void);
+
+/**
+ * Closes the cell (rccl_close for every robot). Returns 0, or the first error of the session
+ * as rccl_close() does (RTC_E_TERMINATED, RTC_E_MOTION, a refused mnp_move's code). Handles
+ * are invalid afterwards.
+ */
+int rcclRelease(int power_off);
+
+/** setvel, setmod, settime for one robot of the cell (units as there). 0 or RTC_E_ARGUMENT. */
+int mnp_setvel(MANIP* m, double mm_per_s, double deg_per_s);
+int mnp_setmod(MANIP* m, int mode);
+int mnp_settime(MANIP* m, double transition_ms, double segment_ms);
+
+/**
+ * move() for one robot of the cell: queues a motion to `p` and returns 0 (or an error code,
+ * as move()). Its number, for mnp_after and the mnp_ tests, is mnp_last_motion(m) afterwards.
+ * It waits for the conditions set by mnp_after / rccl_together since the robot's last
+ * mnp_move, which it takes.
+ */
+int mnp_move(MANIP* m, POS_PTR p);
+/** The number of the robot's last motion queued (1, 2, ...; 0 before the first). */
+int mnp_last_motion(const MANIP* m);
+
+/**
+ * The next mnp_move of `m` starts only once motion `motion` of robot `other` has started
+ * (RCCL_START) or ended (RCCL_END); at most 4 per motion. If that motion fails, or `other`'s
+ * control ends first, the waiting motion is cancelled with the reason (printed, like a
+ * failure). Returns 0, or RTC_E_ARGUMENT (a null handle, a motion never queued, a bad event).
+ */
+int mnp_after(MANIP* m, MANIP* other, int motion, int event);
+
+/**
+ * A joint start: the next mnp_move of each listed robot (a NULL-terminated list of MANIP*)
+ * starts in the same sample as the others'; with `end_together` nonzero they also come to rest
+ * in the same sample, the faster ones slowed to the slowest. 0 or RTC_E_ARGUMENT.
+ */
+int rccl_together(int end_together, ...);
+
+/** 1 once motion `motion` of `m` has started / ended (failed or cancelled included). */
+int mnp_started(const MANIP* m, int motion);
+int mnp_ended(const MANIP* m, int motion);
+/** 1 when every motion queued for `m` has ended: waitfor(mnp_completed(m)). */
+int mnp_completed(const MANIP* m);
+
+/** The robot's park position (its ready pose, in joints). */
+POS_PTR mnp_park(MANIP* m);
+/** The robot's tool transform from the cell file (T6 to the tool point; identity without). */
+TRSF_PTR mnp_tool(MANIP* m);
+/** BASE^-1 of the robot (constant): makeposition(..., EQ, mnp_base_inv(m), world_goal, ...). */
+TRSF_PTR mnp_base_inv(MANIP* m);
+/**
+ * A functional transform: robot `leader`'s commanded tool frame in the world at each sample,
+ * so that another robot follows what `leader` holds (EQ, mnp_base_inv(m), mnp_tool_frame(l),
+ * grasp).
+ */
+TRSF_PTR mnp_tool_frame(MANIP* leader);
+
 #ifdef __cplusplus
 }
 #endif

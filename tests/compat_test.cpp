@@ -23,6 +23,7 @@ class Compat : public ::testing::Test {
   }
   void TearDown() override {
     rccl_close(0);  // RTC_E_SEQUENCE when no session is open
+    rcclRelease(0);
   }
 };
 
@@ -154,3 +155,44 @@ TEST_F(Compat, WaitforEndAndCompletedOnTheSimulatedMicrobo) {
 }
 
 }  // namespace
+
+TEST_F(Compat, TheCellsRobotHandlesRefuseWhatCannotWork) {
+  EXPECT_EQ(rcclCreate("puma", 0), nullptr);
+  EXPECT_EQ(rtc_error, RTC_E_SEQUENCE);
+  EXPECT_EQ(rccl_cell_open("/nonexistent/cell.json"), RTC_E_ROBOT);
+  EXPECT_NE(message().find("/nonexistent/cell.json"), std::string::npos) << message();
+  ASSERT_EQ(rccl_cell_open(nullptr), RTC_OK) << message();  // the shipped CVaRL cell
+  EXPECT_EQ(rccl_open("microbo", 0), RTC_E_SEQUENCE);
+  EXPECT_EQ(rcclCreate("scara", 0), nullptr);
+  EXPECT_EQ(rtc_error, RTC_E_ROBOT);
+  EXPECT_NE(message().find("puma, microbo"), std::string::npos) << message();
+  MANIP* puma = rcclCreate("puma", 0);
+  MANIP* mbo = rcclCreate("microbo", 0);
+  ASSERT_NE(puma, nullptr);
+  ASSERT_NE(mbo, nullptr);
+  EXPECT_EQ(rcclCreate("puma", 0), puma) << "one handle per robot";
+  EXPECT_EQ(mnp_move(puma, mnp_park(puma)), RTC_E_SEQUENCE) << "before rcclStart";
+  ASSERT_EQ(rcclStart(), RTC_OK) << message();
+  EXPECT_EQ(mnp_setvel(nullptr, 10.0, 10.0), RTC_E_ARGUMENT);
+  EXPECT_EQ(mnp_setmod(puma, 'x'), RTC_E_ARGUMENT);
+  EXPECT_EQ(mnp_after(mbo, puma, 1, RCCL_END), RTC_E_ARGUMENT) << "puma has queued nothing";
+  EXPECT_NE(message().find("mnp_last_motion"), std::string::npos) << message();
+  EXPECT_EQ(move(park), RTC_E_SEQUENCE) << "the one-robot move() names no robot";
+  EXPECT_NE(message().find("mnp_move"), std::string::npos) << message();
+  EXPECT_EQ(rccl_together(0, puma, reinterpret_cast<MANIP*>(&rtc_error), nullptr), RTC_E_ARGUMENT);
+  // A hand-off: the Microbo's park waits for the PUMA's park to end.
+  ASSERT_EQ(mnp_move(puma, mnp_park(puma)), RTC_OK) << message();
+  const int a = mnp_last_motion(puma);
+  ASSERT_EQ(mnp_after(mbo, puma, a, RCCL_END), RTC_OK) << message();
+  ASSERT_EQ(mnp_move(mbo, mnp_park(mbo)), RTC_OK) << message();
+  const int b = mnp_last_motion(mbo);
+  waitfor(mnp_ended(puma, a));
+  EXPECT_EQ(mnp_started(mbo, b), 0);
+  waitfor(mnp_completed(mbo));
+  EXPECT_EQ(mnp_ended(mbo, b), 1);
+  EXPECT_EQ(completed, 1);
+  const int refused_code = rcclRelease(0);
+  // The refused calls above are reported at the end, like rccl_close's.
+  EXPECT_EQ(refused_code, RTC_E_SEQUENCE) << message();
+  EXPECT_EQ(mnp_move(puma, mnp_park(puma)), RTC_E_ARGUMENT) << "handles die with the cell";
+}
