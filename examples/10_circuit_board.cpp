@@ -75,14 +75,15 @@ constexpr double kPadRadius = 2_mm;
 
 constexpr double kDwellS = 0.5;        ///< on each pad, s
 constexpr double kRepairS = 1.5;       ///< on the repaired pad, hand closed, s
-constexpr double kProbeAbove = 30_mm;  ///< where the probe waits above a pad
-constexpr double kTravel = 40_mm;      ///< the board's slow move, along the world's y
+constexpr double kProbeAbove = 30_mm;  ///< where the probe waits above a pad, m
+constexpr double kTravel = 40_mm;      ///< the board's slow move, along the world's y, m
 
 /// The Microbo's measurements on one pad.
 struct PadResult {
   double touched_s = 0.0;  ///< when the descent ended, s
   double max_error_m = 0.0;
   double sum_error_m = 0.0;
+  double last_error_m = 0.0;  ///< at the dwell's end: settled, without the landing's lag
   int samples = 0;
   double board_speed_m_per_s = 0.0;  ///< of the pad, measured over the dwell
   bool hand_closed = false;          ///< the Microbo reported its hand closed during the dwell
@@ -277,6 +278,7 @@ int main(int argc, char** argv) {
       const double e = (tip - truth).norm();
       r.max_error_m = std::max(r.max_error_m, e);
       r.sum_error_m += e;
+      r.last_error_m = e;
       ++r.samples;
       if (first_s < 0.0) {
         first_s = hm.time_s;
@@ -364,7 +366,8 @@ int main(int argc, char** argv) {
       "touch of {}\n\n",
       presented_s, kTravel * 1e3, moving_speed_mm_s, kPads[kStartMovingAfter].name);
   fmt::print(
-      " pad   x mm   y mm  board     touched s  dwell s  samples  error mm max / mean  hand\n");
+      " pad   x mm   y mm  board     touched s  dwell s  samples  error mm max / mean / end  "
+      "hand\n");
   double worst_m = 0.0;
   int moving_pads = 0;
   std::FILE* csv = csv_path.empty() ? nullptr : std::fopen(csv_path.c_str(), "w");
@@ -375,7 +378,7 @@ int main(int argc, char** argv) {
   if (csv != nullptr) {
     fmt::print(csv,
                "pad,x_mm,y_mm,board_speed_mm_s,touched_s,samples,max_error_mm,"
-               "mean_error_mm,hand_closed\n");
+               "mean_error_mm,end_error_mm,hand_closed\n");
   }
   for (std::size_t i = 0; i < kPads.size(); ++i) {
     const Pad& p = kPads[i];
@@ -386,15 +389,16 @@ int main(int argc, char** argv) {
     const double mean_m = r.samples > 0 ? r.sum_error_m / r.samples : 0.0;
     worst_m = std::max(worst_m, r.max_error_m);
     good = good && r.samples > 0;
-    fmt::print("{:4} {:6.1f} {:6.1f}  {:<9} {:9.2f} {:8.2f} {:8}  {:8.3f} / {:6.3f}  {}\n", p.name,
-               p.x_mm, p.y_mm,
-               moving ? fmt::format("{:.1f} mm/s", r.board_speed_m_per_s * 1e3) : "still",
-               r.touched_s, i == kRepairPad ? kRepairS : kDwellS, r.samples, r.max_error_m * 1e3,
-               mean_m * 1e3, r.hand_closed ? "closed" : "open");
+    fmt::print(
+        "{:4} {:6.1f} {:6.1f}  {:<9} {:9.2f} {:8.2f} {:8}  {:8.3f} / {:5.3f} / {:5.3f}  {}\n",
+        p.name, p.x_mm, p.y_mm,
+        moving ? fmt::format("{:.1f} mm/s", r.board_speed_m_per_s * 1e3) : "still", r.touched_s,
+        i == kRepairPad ? kRepairS : kDwellS, r.samples, r.max_error_m * 1e3, mean_m * 1e3,
+        r.last_error_m * 1e3, r.hand_closed ? "closed" : "open");
     if (csv != nullptr) {
-      fmt::print(csv, "{},{},{},{:.3f},{:.3f},{},{:.4f},{:.4f},{}\n", p.name, p.x_mm, p.y_mm,
+      fmt::print(csv, "{},{},{},{:.3f},{:.3f},{},{:.4f},{:.4f},{:.4f},{}\n", p.name, p.x_mm, p.y_mm,
                  r.board_speed_m_per_s * 1e3, r.touched_s, r.samples, r.max_error_m * 1e3,
-                 mean_m * 1e3, r.hand_closed ? 1 : 0);
+                 mean_m * 1e3, r.last_error_m * 1e3, r.hand_closed ? 1 : 0);
     }
   }
   if (csv != nullptr && std::fclose(csv) != 0) {
