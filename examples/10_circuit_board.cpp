@@ -29,8 +29,9 @@
 // What it measures, per pad, at every Microbo sample of the dwell: the distance between the
 // Microbo's measured probe tip (forward kinematics of the joints its RCU reports, through its
 // base and tool) and where the pad really is at that instant (from the joints the PUMA reports:
-// base FK(q) TOOL GRASP PAD). It exits 1 when a motion failed, the collision check stopped the
-// arms, or a probe missed its pad by more than kPadRadius.
+// base FK(q) TOOL GRASP PAD), its max, mean and value at the dwell's end, and the pad's measured
+// speed. It exits 1 when a motion failed, the collision check stopped the arms, or a probe
+// missed its pad by more than kPadRadius; 2 for a bad option.
 // Run: ./build/release/examples/10_circuit_board [--moving-speed 5] [--csv pads.csv]
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
@@ -40,6 +41,7 @@
 #include <chrono>
 #include <cstdio>
 #include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -123,8 +125,8 @@ int main(int argc, char** argv) {
   }
 
   // The default options: collision checks on, each robot on its own plant (not ideal_servo).
-  const auto cell = cell::Cell::load(cell_path);
-  cell::Cell& c = *cell;
+  const std::unique_ptr<cell::Cell> loaded = cell::Cell::load(cell_path);
+  cell::Cell& c = *loaded;
   const cell::CellRobot& puma_model = *c.model().find_robot("puma");
   const cell::CellRobot& microbo_model = *c.model().find_robot("microbo");
   const math::Transform puma_tool = puma_model.tool.value();
