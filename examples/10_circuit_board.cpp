@@ -61,7 +61,7 @@ struct Pad {
   double y_mm;
 };
 // The Microbo probes from the +x side; the PUMA holds the board's -x edge (GRASP), so the pads
-// stay at x >= -20 mm: the arms' capsules then keep more than 50 mm apart (see the closest
+// stay at x >= -20 mm: the arms' capsules then keep more than 40 mm apart (see the closest
 // approach the program prints).
 constexpr std::array kPads{Pad{"TP1", -20, -25}, Pad{"TP2", 5, -30}, Pad{"TP3", 30, -25},
                            Pad{"TP4", 35, 0},    Pad{"TP5", 30, 25}, Pad{"TP6", 5, 30},
@@ -71,8 +71,8 @@ constexpr std::size_t kStartMovingAfter = 2;  // TP3
 /// The pad repaired (a longer dwell with the hand closed): U1, a component's lead.
 constexpr std::size_t kRepairPad = kPads.size() - 1;
 
-/// How far a probe may land from a pad's centre and still touch it: the pads are 4 mm across,
-/// the size of a hybrid circuit's test pads (thesis 1.1.1), m.
+/// How far a probe may land from a pad's centre and still touch it: we take the pads to be 4 mm
+/// across (the thesis gives no size), m.
 constexpr double kPadRadius = 2_mm;
 
 constexpr double kDwellS = 0.5;        ///< on each pad, s
