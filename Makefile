@@ -9,7 +9,7 @@ FUZZ_DIR := build/fuzz
 # Seconds all fuzz targets get together in `make test` (scripts/fuzz shares them out).
 FUZZ_SECONDS ?= 60
 
-.PHONY: all deps demo test unit-tests fuzz tsan bench build-debug build-release format format-check clean
+.PHONY: all deps demo demo-cell test unit-tests fuzz tsan bench build-debug build-release format format-check clean
 
 all: build-release
 
@@ -31,6 +31,10 @@ build-release: deps $(RELEASE_DIR)/CMakeCache.txt
 # The main example: the thesis's window washer in RCCL motion equations, on the simulated Microbo.
 demo: build-release
 	$(RELEASE_DIR)/examples/04_washer
+
+# The two-robot demo on the CVaRL cell: the PUMA presents a circuit board, the Microbo probes it.
+demo-cell: build-release
+	$(RELEASE_DIR)/examples/10_circuit_board
 
 # Debug build with AddressSanitizer and UndefinedBehaviorSanitizer, every test, then the
 # fuzz targets for FUZZ_SECONDS in all.

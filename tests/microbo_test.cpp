@@ -276,3 +276,33 @@ INSTANTIATE_TEST_SUITE_P(
     [](const ::testing::TestParamInfo<RcuFaultCase>& p) {
       return std::string(hw::to_string(p.param.fault));
     });
+
+TEST(MicroboSession, AJointWhosePosvelTargetStopsWithRoundingNoiseStillReachesIt) {
+  // A Cartesian motion that has ended on a moving goal keeps sending every joint's setpoint;
+  // a joint that no longer moves (d2, when the goal moves sideways) gets the same value again,
+  // give or take a rounding of its inverse kinematics. Move d2 down at 28 mm/s from the start
+  // (the driver's desired point falls behind), slow it smoothly to rest, as the trajectory
+  // generator does, then hold its last target with noise of 1e-16 m: it must settle on it as it
+  // does on an exact value.
+  for (const double noise : {0.0, 1e-16}) {
+    MicroboSession m(28ms);
+    const double top = 0.028;  // m/s
+    double range = 0.0;
+    int k = 0;
+    m.session.control(
+        [&](rtc::Control& c) {
+          if (k == 0) range = c.how().joint[1].range;
+          // 30 samples at speed, then down to rest in 20.
+          const double speed = k < 30 ? top : k < 50 ? top * (50 - k) / 20.0 : 0.0;
+          range -= speed * c.period_s();
+          c.chg().posvel(1, range + (k % 2 == 0 ? noise : -noise));
+          ++k;
+        },
+        {});
+    ASSERT_FALSE(m.session.wait_for(3s).ended()) << rtc::to_string(m.session.termination().code);
+    const double off_counts = std::abs(m.session.how().joint[1].range - range) / m.count(1);
+    EXPECT_LT(off_counts, 20) << "noise " << noise << " m: d2 held " << off_counts
+                              << " counts off its target";
+    m.session.release();
+  }
+}

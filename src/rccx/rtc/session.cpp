@@ -924,9 +924,14 @@ void Session::apply(CommState& c, const Chg& chg) noexcept {
     }
     const double from = c.has_target[i] ? c.last_target[i] : j.q;
     const double top = driver_.velocity_limit(i, period_s);  // at most the model's top speed
-    double rate = m.set == SetMode::posvel
-                      ? std::abs(target - from) / period_s
-                      : (m.velocity > 0.0 ? m.velocity : kDefaultSpeedFraction * top);
+    // POSVEL to the last target again, give or take a rounding (a joint that a Cartesian motion
+    // no longer moves): rate 0, at once. A rate of 1e-13 m/s would leave a driver that paces its
+    // desired point by the rate (the Microbo's) behind the target for good.
+    double rate =
+        m.set == SetMode::posvel
+            ? (std::abs(target - from) <= kin::kLimitTolerance ? 0.0
+                                                               : std::abs(target - from) / period_s)
+            : (m.velocity > 0.0 ? m.velocity : kDefaultSpeedFraction * top);
     if (!(rate <= top * (1.0 + 1e-9))) {
       j.flags |= kTargetVelocityOut;
       if ((chg.checking & kCheckTargetVelocity) != 0 || !std::isfinite(rate)) {

@@ -1,0 +1,439 @@
+// Example 10: two robots inspect and repair a circuit board (thesis 4.5, figure 4.8), on the
+// CVaRL cell (cells/cvarl.json) in simulated time, each on its own simulated plant: the PUMA
+// 260's PID servos on its dynamics, the Microbo's emulated RCU.
+//
+// The PUMA picks the board off the x-y stage and presents it to the Microbo. From the grasp on,
+// the board is wherever the PUMA's tool is:
+//
+//     board (world) = PUMA_TOOL GRASP             PUMA_TOOL = cell.tool_frame("puma")
+//
+// so each test pad the Microbo probes is a position equation through the other robot's frame,
+//
+//     T6 TOOL = BASE_INV(microbo) PUMA_TOOL GRASP PAD DOWN     (DOWN: the probe onto the pad)
+//
+// a functional transform the Microbo's generator evaluates every sample: its goals stay on the
+// pads while the PUMA moves the board. The PUMA's own goals are written for the board frame
+// (T6 TOOL GRASP = BASE_INV(puma) BOARD, the board the tool), so it carries the board on
+// straight lines.
+//
+// The sequence, synchronised by events (the PUMA's motion ends, the Microbo's):
+//   1. The Microbo backs off; the PUMA goes above the board, descends, closes its hand, lifts the
+//      board off the stage and presents it nearer the Microbo.
+//   2. When the presentation has ended, the Microbo probes the pads one by one: above, down to
+//      touch, a dwell on the pad, up.
+//   3. When the Microbo has touched pad TP3, the PUMA starts a slow translation of the board
+//      (--moving-speed, mm/s): the next pads are probed on a moving board.
+//   4. One pad is repaired: a longer dwell with the Microbo's hand closed.
+//   5. The Microbo backs off; the PUMA puts the board back on the stage and parks.
+//
+// What it measures, per pad, at every Microbo sample of the dwell: the distance between the
+// Microbo's measured probe tip (forward kinematics of the joints its RCU reports, through its
+// base and tool) and where the pad really is at that instant (from the joints the PUMA reports:
+// base FK(q) TOOL GRASP PAD), its max, mean and value at the dwell's end, and the pad's measured
+// speed. It exits 1 when a motion failed, the collision check stopped the arms, or a probe
+// missed its pad by more than kPadRadius; 2 for a bad option.
+// Run: ./build/release/examples/10_circuit_board [--moving-speed 5] [--csv pads.csv]
+#include <fmt/format.h>
+#include <CLI/CLI.hpp>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cstdio>
+#include <limits>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "rccx/cell/cell.hpp"
+#include "rccx/math/units.hpp"
+
+using namespace rccx;
+using namespace rccx::math::literals;
+using namespace std::chrono_literals;
+
+namespace {
+
+/// A test pad on the board: board frame (the top face's centre, x towards the Microbo), mm.
+struct Pad {
+  const char* name;
+  double x_mm;
+  double y_mm;
+};
+// The Microbo probes from the +x side; the PUMA holds the board's -x edge (GRASP), so the pads
+// stay at x >= -20 mm: the arms' capsules then keep more than 40 mm apart (see the closest
+// approach the program prints).
+constexpr std::array kPads{Pad{"TP1", -20, -25}, Pad{"TP2", 5, -30}, Pad{"TP3", 30, -25},
+                           Pad{"TP4", 35, 0},    Pad{"TP5", 30, 25}, Pad{"TP6", 5, 30},
+                           Pad{"TP7", -20, 25},  Pad{"U1", 5, 0}};
+/// Touching this pad starts the PUMA's slow move: the next ones are probed on a moving board.
+constexpr std::size_t kStartMovingAfter = 2;  // TP3
+/// The pad repaired (a longer dwell with the hand closed): U1, a component's lead.
+constexpr std::size_t kRepairPad = kPads.size() - 1;
+
+/// How far a probe may land from a pad's centre and still touch it: we take the pads to be 4 mm
+/// across (the thesis gives no size), m.
+constexpr double kPadRadius = 2_mm;
+
+constexpr double kDwellS = 0.5;        ///< on each pad, s
+constexpr double kRepairS = 1.5;       ///< on the repaired pad, hand closed, s
+constexpr double kProbeAbove = 30_mm;  ///< where the probe waits above a pad, m
+constexpr double kTravel = 40_mm;      ///< the board's slow move, along the world's y, m
+
+/// The Microbo's measurements on one pad.
+struct PadResult {
+  double touched_s = 0.0;  ///< when the descent ended, s
+  double max_error_m = 0.0;
+  double sum_error_m = 0.0;
+  double last_error_m = 0.0;  ///< at the dwell's end: settled, without the landing's lag
+  int samples = 0;
+  double board_speed_m_per_s = 0.0;  ///< of the pad, measured over the dwell
+  bool hand_closed = false;          ///< the Microbo reported its hand closed during the dwell
+};
+
+/// The tool pointing down (approach -z) at a point of a frame whose z is up: the probe's pose.
+math::Transform down_at(double x_m, double y_m, double z_m) {
+  return {math::Rot3::rot_x(math::kPi), {x_m, y_m, z_m}};
+}
+
+bool reached(rccl::WaitResult w) {
+  return w == rccl::WaitResult::reached;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "The PUMA 260 presents a circuit board and the Microbo probes its test pads, some while "
+      "the board moves (thesis 4.5, figure 4.8; CVaRL cell, simulated time)."};
+  double moving_speed_mm_s = 5.0;
+  std::string csv_path;
+  std::string cell_path = RCCX_CVARL_CELL;
+  app.add_option("--moving-speed", moving_speed_mm_s,
+                 "speed of the board's slow move while the Microbo probes, mm/s")
+      ->check(CLI::Range(1.0, 20.0))
+      ->capture_default_str();
+  app.add_option("--csv", csv_path, "also write the table to this CSV file (mm, s)");
+  app.add_option("--cell", cell_path, "the cell file (the CVaRL cell's layout)")
+      ->check(CLI::ExistingFile)
+      ->capture_default_str();
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    // --help exits 0; bad input 2, as every rccx command (docs/RELIABILITY.md).
+    return app.exit(e) == 0 ? 0 : 2;
+  }
+
+  // The default options: collision checks on, each robot on its own plant (not ideal_servo).
+  const std::unique_ptr<cell::Cell> loaded = cell::Cell::load(cell_path);
+  cell::Cell& c = *loaded;
+  const cell::CellRobot& puma_model = *c.model().find_robot("puma");
+  const cell::CellRobot& microbo_model = *c.model().find_robot("microbo");
+  const math::Transform puma_tool = puma_model.tool.value();
+  const math::Transform microbo_tool = microbo_model.tool.value();
+
+  // Where the board lies on the stage, and where the PUMA presents it: 60 mm nearer the Microbo
+  // and 38 mm higher, so that every pad is mid-travel for the Microbo's d2 (200 .. 330 mm: the
+  // probe's tip at 140 .. 170 mm puts it at 265 .. 295 mm) and d3 (245 .. 330 mm of 150 .. 450).
+  const math::Transform board_home = c.model().find_frame("board_home")->pose;
+  const math::Transform presented = math::Transform::translation(60_mm, 0, 140_mm);
+  const math::Transform presented_end = math::Transform::translation(60_mm, kTravel, 140_mm);
+
+  // GRASP: the PUMA's fingers on the middle of the board's -x edge (5 mm in), the approach
+  // tilted 45 deg from the vertical towards +x, turned 30 deg towards +y (Rot_y 135 deg, then
+  // Rot_z 30 deg): the wrist stays 116 mm above the edge and 100 mm behind it, 58 mm to the
+  // side, away from the Microbo reaching over the board from +x (its capsules keep more than
+  // 40 mm from the PUMA's), and far enough from the PUMA's own shoulder axis: with the approach
+  // straight along x, lifting the board took theta3 past its -235 deg limit. board = PUMA_TOOL
+  // GRASP.
+  const math::Transform tool_on_board =
+      math::Transform::translation(-45_mm, 0, 0) *
+      math::Transform{math::Rot3::rot_z(30_deg) * math::Rot3::rot_y(135_deg), {}};
+  const math::Transform grasp_value = tool_on_board.inverse();
+
+  // --- Reachability, before anything moves: every goal solved within both arms' limits -------
+  const kin::Kinematics& puma_kin = c.robot("puma").kinematics();
+  const kin::Kinematics& microbo_kin = c.robot("microbo").kinematics();
+  const auto puma_t6 = [&](const math::Transform& board) {
+    return c.world_to_base("puma", board * tool_on_board * puma_tool.inverse());
+  };
+  const auto microbo_t6 = [&](const math::Transform& board, const Pad& pad, double above_m) {
+    return c.world_to_base("microbo", board * down_at(pad.x_mm * 1e-3, pad.y_mm * 1e-3, above_m) *
+                                          microbo_tool.inverse());
+  };
+  const math::Transform lifted = board_home * math::Transform::translation(0, 0, 25_mm);
+  const math::Transform over_home = board_home * math::Transform::translation(0, 0, 25_mm);
+  int puma_goals = 0, microbo_goals = 0, unreachable = 0;
+  const auto check = [&](const kin::Kinematics& k, const math::Transform& t6, int& goals,
+                         const std::string& what) {
+    ++goals;
+    const kin::IkResult r = k.inverse(t6);
+    if (!r) {
+      ++unreachable;
+      fmt::print(stderr, "{} cannot reach {}: {}\n", k.model().name, what, kin::describe(r.status));
+    }
+  };
+  for (const math::Transform& b : {over_home, board_home, lifted, presented, presented_end}) {
+    check(puma_kin, puma_t6(b), puma_goals,
+          fmt::format("the board at ({:.0f}, {:.0f}, {:.0f}) mm", b.p.x * 1e3, b.p.y * 1e3,
+                      b.p.z * 1e3));
+  }
+  for (const math::Transform& b : {presented, presented_end}) {
+    for (const Pad& pad : kPads) {
+      for (const double above : {0.0, kProbeAbove}) {
+        check(microbo_kin, microbo_t6(b, pad, above), microbo_goals,
+              fmt::format("{} {:.0f} mm above, board at y = {:.0f} mm", pad.name, above * 1e3,
+                          b.p.y * 1e3));
+      }
+    }
+  }
+  fmt::print(
+      "reach: {} PUMA goals (board on the stage, lifted, presented, moved) and {} Microbo "
+      "goals (each pad and above it, board presented and moved): {} unreachable\n",
+      puma_goals, microbo_goals, unreachable);
+  if (unreachable > 0) return 1;
+
+  // The closest the two arms' capsules come, from every tick's collision world.
+  double closest_m = std::numeric_limits<double>::infinity();
+  c.set_cycle_observer([&](std::uint32_t) {
+    closest_m = std::min(closest_m, c.collision_world().min_distance(0, 1).distance_m);
+  });
+  c.start();
+  rccl::Manipulator& puma = c.robot("puma");
+  rccl::Manipulator& microbo = c.robot("microbo");
+  rtc::Session& puma_session = c.session("puma");
+  rtc::Session& microbo_session = c.session("microbo");
+
+  // --- Equations --------------------------------------------------------------------------------
+  const auto t6 = rccl::t6();
+  const auto ptool = rccl::constant("PTOOL", puma_tool);
+  const auto grasp = rccl::constant("GRASP", grasp_value);
+  // T6 PTOOL GRASP = BASE_INV(puma) BOARD, tool GRASP: Cartesian moves carry the board straight.
+  const auto board_at = [&](const char* name, const math::Transform& board) {
+    return rccl::Position::make(name, {t6, ptool, grasp},
+                                {c.in_base_of("puma", rccl::constant(name, board))}, grasp);
+  };
+  const auto p_over = board_at("OVER_BOARD", over_home);
+  const auto p_grip = board_at("ON_BOARD", board_home);
+  const auto p_lift = board_at("LIFT", lifted);
+  const auto p_present = board_at("PRESENT", presented);
+  const auto p_moved = board_at("MOVED", presented_end);
+
+  // T6 MTOOL = BASE_INV(microbo) PUMA_TOOL GRASP PAD DOWN: on the pad wherever the PUMA holds it.
+  const auto mtool = rccl::constant("MTOOL", microbo_tool);
+  const auto puma_frame = c.in_base_of("microbo", c.tool_frame("puma"));
+  const auto mgrasp = rccl::constant("GRASP", grasp_value);
+  std::vector<rccl::PositionPtr> above, touch;
+  for (const Pad& pad : kPads) {
+    const auto probe = [&](const std::string& name, double z_m) {
+      const auto at = rccl::constant(name, down_at(pad.x_mm * 1e-3, pad.y_mm * 1e-3, z_m));
+      return rccl::Position::make(name, {t6, mtool}, {puma_frame, mgrasp, at}, mtool);
+    };
+    above.push_back(probe(std::string("ABOVE_") + pad.name, kProbeAbove));
+    touch.push_back(probe(std::string("TOUCH_") + pad.name, 0.0));
+  }
+  // Where the Microbo waits, out of the PUMA's way: d3 at 200 mm puts its wrist 150 mm in x
+  // from the board's centre, 300 mm up; tool down as in its ready pose.
+  kin::JointVector wait_q = microbo_kin.model().ready();
+  wait_q[1] = 0.300;
+  wait_q[2] = 0.200;
+  const auto m_wait = rccl::Position::joints("MICROBO_WAIT", wait_q);
+  fmt::print("{}\n{}\n", p_present->describe(), touch.front()->describe());
+
+  // --- Measurement ----------------------------------------------------------------------------
+  // The PUMA's recent measured joints by sample time: its How and the Microbo's come from the same
+  // tick only every fourth tick, and either may be published a tick late (the pipeline).
+  struct Reading {
+    double t_s = -1.0;
+    kin::JointVector q;
+  };
+  std::array<Reading, 16> puma_recent{};
+  std::size_t puma_next = 0;
+  double microbo_last_s = -1.0;
+  const auto pad_world = [&](const kin::JointVector& q, const Pad& pad) {
+    return (puma_model.base * puma_kin.forward(q) * puma_tool * grasp_value *
+            math::Vec3{pad.x_mm * 1e-3, pad.y_mm * 1e-3, 0.0});
+  };
+  // Lets `seconds` pass one tick at a time, measuring the probe against `pad` at every instant
+  // both arms were read.
+  const auto measure = [&](const Pad& pad, double seconds, PadResult& r) {
+    const double until_s = microbo_session.how().time_s + seconds;
+    double first_s = -1.0, last_s = -1.0;
+    math::Vec3 first_p, last_p;
+    while (microbo_session.how().time_s < until_s && microbo_session.controlling()) {
+      c.wait_for(c.model().base_period);
+      const rtc::How hp = puma_session.how();
+      if (hp.time_s != puma_recent[(puma_next + puma_recent.size() - 1) % puma_recent.size()].t_s) {
+        puma_recent[puma_next] = {hp.time_s, hp.q()};
+        puma_next = (puma_next + 1) % puma_recent.size();
+      }
+      const rtc::How hm = microbo_session.how();
+      if (hm.time_s == microbo_last_s) continue;
+      microbo_last_s = hm.time_s;
+      r.hand_closed = r.hand_closed || hm.hand_closed;
+      const auto same = std::find_if(puma_recent.begin(), puma_recent.end(),
+                                     [&](const Reading& x) { return x.t_s == hm.time_s; });
+      if (same == puma_recent.end()) continue;
+      const math::Vec3 tip =
+          (microbo_model.base * microbo_kin.forward(hm.q()) * microbo_tool).p;  // measured
+      const math::Vec3 truth = pad_world(same->q, pad);
+      const double e = (tip - truth).norm();
+      r.max_error_m = std::max(r.max_error_m, e);
+      r.sum_error_m += e;
+      r.last_error_m = e;
+      ++r.samples;
+      if (first_s < 0.0) {
+        first_s = hm.time_s;
+        first_p = truth;
+      }
+      last_s = hm.time_s;
+      last_p = truth;
+    }
+    if (last_s > first_s) r.board_speed_m_per_s = (last_p - first_p).norm() / (last_s - first_s);
+  };
+
+  // --- 1. Pick and present --------------------------------------------------------------------
+  constexpr auto kTimeout = 60s;
+  bool good = true;
+  const auto wait = [&](rccl::Manipulator& m, const rccl::Event& e) {
+    good = good && reached(m.waitfor(e, kTimeout));
+  };
+  puma.set_velocity(80_mm, 45_deg);  // joint moves, too, take their time from these
+  microbo.set_velocity(80_mm, 45_deg);
+  // The arms start 57 mm apart (both ready poses reach over the board): the Microbo backs off
+  // first, and the PUMA sets off once that motion has ended.
+  wait(microbo, microbo.move(m_wait).end());
+  puma.move(p_over);
+  puma.set_mode(rccl::Mode::cartesian);
+  puma.set_velocity(30_mm, 30_deg);
+  const rccl::Motion descend = puma.move(p_grip);
+  wait(puma, descend.end());
+  puma.set_hand(true);
+  wait(puma, puma.dwell(0.5).end());  // the fingers close on the board's edge
+  puma.set_velocity(50_mm, 30_deg);
+  puma.move(p_lift);
+  const rccl::Motion present = puma.move(p_present);
+  // The Microbo starts only once the board stands still where it is presented.
+  wait(puma, present.end());
+  wait(microbo, microbo.completed());
+  const double presented_s = puma_session.how().time_s;
+
+  // --- 2-4. Probe, with the board moving for some pads, and repair one -------------------------
+  std::array<PadResult, kPads.size()> results{};
+  microbo.set_mode(rccl::Mode::cartesian);
+  microbo.set_velocity(40_mm, 45_deg);
+  rccl::Motion slow{};
+  for (std::size_t i = 0; i < kPads.size() && good; ++i) {
+    microbo.move(above[i]);
+    const rccl::Motion down = microbo.move(touch[i]);
+    wait(microbo, down.end());
+    results[i].touched_s = microbo.report(down).end_s;
+    if (i == kStartMovingAfter) {
+      // The Microbo has touched TP3: the PUMA starts carrying the board slowly along y.
+      puma.set_velocity(moving_speed_mm_s * 1e-3, 10_deg);
+      slow = puma.move(p_moved);
+    }
+    // The dwell is time let pass, not microbo.dwell(): a queued dwell holds the joints, while a
+    // motion to a moving goal that has ended keeps tracking it.
+    if (i == kRepairPad) {
+      microbo.set_hand(true);
+      measure(kPads[i], kRepairS, results[i]);
+      microbo.set_hand(false);
+    } else {
+      measure(kPads[i], kDwellS, results[i]);
+    }
+    microbo.move(above[i]);  // up
+  }
+  if (slow.id != 0) wait(puma, slow.end());
+  // --- 5. Both back ----------------------------------------------------------------------------
+  microbo.set_mode(rccl::Mode::joint);
+  const rccl::Motion away = microbo.move(m_wait);
+  wait(microbo, away.end());  // out of the PUMA's way before it turns back
+  puma.set_velocity(50_mm, 30_deg);
+  puma.move(p_lift);
+  puma.set_velocity(30_mm, 30_deg);
+  wait(puma, puma.move(p_grip).end());
+  puma.set_hand(false);
+  wait(puma, puma.dwell(0.5).end());
+  puma.move(p_over);
+  puma.set_mode(rccl::Mode::joint);
+  puma.set_velocity(80_mm, 45_deg);
+  puma.move(puma.park());
+  wait(puma, puma.completed());
+  const double end_s = puma_session.how().time_s;
+
+  // --- The table ---------------------------------------------------------------------------------
+  fmt::print(
+      "\nboard presented at {:.2f} s; the PUMA moves it {:.0f} mm along y at {:.1f} mm/s from the "
+      "touch of {}\n\n",
+      presented_s, kTravel * 1e3, moving_speed_mm_s, kPads[kStartMovingAfter].name);
+  fmt::print(
+      " pad   x mm   y mm  board     touched s  dwell s  samples  error mm max / mean / end  "
+      "hand\n");
+  double worst_m = 0.0;
+  int moving_pads = 0;
+  std::FILE* csv = csv_path.empty() ? nullptr : std::fopen(csv_path.c_str(), "w");
+  if (!csv_path.empty() && csv == nullptr) {
+    fmt::print(stderr, "cannot write {}\n", csv_path);
+    good = false;
+  }
+  if (csv != nullptr) {
+    fmt::print(csv,
+               "pad,x_mm,y_mm,board_speed_mm_s,touched_s,samples,max_error_mm,"
+               "mean_error_mm,end_error_mm,hand_closed\n");
+  }
+  for (std::size_t i = 0; i < kPads.size(); ++i) {
+    const Pad& p = kPads[i];
+    const PadResult& r = results[i];
+    // Moving: the pad travelled faster than 0.5 mm/s while probed (the servos' drift is far less).
+    const bool moving = r.board_speed_m_per_s > 0.5_mm;
+    moving_pads += moving ? 1 : 0;
+    const double mean_m = r.samples > 0 ? r.sum_error_m / r.samples : 0.0;
+    worst_m = std::max(worst_m, r.max_error_m);
+    good = good && r.samples > 0;
+    fmt::print(
+        "{:4} {:6.1f} {:6.1f}  {:<9} {:9.2f} {:8.2f} {:8}  {:8.3f} / {:5.3f} / {:5.3f}  {}\n",
+        p.name, p.x_mm, p.y_mm,
+        moving ? fmt::format("{:.1f} mm/s", r.board_speed_m_per_s * 1e3) : "still", r.touched_s,
+        i == kRepairPad ? kRepairS : kDwellS, r.samples, r.max_error_m * 1e3, mean_m * 1e3,
+        r.last_error_m * 1e3, r.hand_closed ? "closed" : "open");
+    if (csv != nullptr) {
+      fmt::print(csv, "{},{},{},{:.3f},{:.3f},{},{:.4f},{:.4f},{:.4f},{}\n", p.name, p.x_mm, p.y_mm,
+                 r.board_speed_m_per_s * 1e3, r.touched_s, r.samples, r.max_error_m * 1e3,
+                 mean_m * 1e3, r.last_error_m * 1e3, r.hand_closed ? 1 : 0);
+    }
+  }
+  if (csv != nullptr && std::fclose(csv) != 0) {
+    fmt::print(stderr, "cannot write {}\n", csv_path);
+    good = false;
+  }
+
+  const std::size_t puma_failures = puma.failures().size();
+  const std::size_t microbo_failures = microbo.failures().size();
+  fmt::print(
+      "\n{} pads probed, {} on the moving board; worst error {:.3f} mm (bound {:.1f} mm)\n"
+      "failures: PUMA {}, Microbo {}; collision stops {}; closest approach of the arms' capsules "
+      "{:.1f} mm (margin {:.0f} mm); simulated time {:.1f} s\n",
+      kPads.size(), moving_pads, worst_m * 1e3, kPadRadius * 1e3,
+      puma_failures == 0 ? std::string("none") : std::to_string(puma_failures),
+      microbo_failures == 0 ? std::string("none") : std::to_string(microbo_failures),
+      c.collision_stops(), closest_m * 1e3, c.model().collision_margin_m * 1e3, end_s);
+
+  std::fflush(stdout);  // the table before the messages on stderr
+  for (rccl::Manipulator* m : {&puma, &microbo}) {
+    for (const rccl::MotionEvent& f : m->failures()) {
+      fmt::print(stderr, "{} motion {} {}: {}\n", m == &puma ? "puma" : "microbo", f.id,
+                 rccl::to_string(f.kind), f.message());
+    }
+  }
+  if (!good || puma_failures + microbo_failures > 0 || c.collision_stops() > 0 ||
+      !puma_session.controlling() || !microbo_session.controlling()) {
+    fmt::print(stderr, "the demonstration did not run through\n");
+    return 1;
+  }
+  if (worst_m > kPadRadius) {
+    fmt::print(stderr, "a probe missed its pad by more than {:.1f} mm\n", kPadRadius * 1e3);
+    return 1;
+  }
+  return 0;
+}
