@@ -16,7 +16,9 @@
 // (T6 TOOL GRASP = BASE_INV(puma) BOARD, the board the tool), so it carries the board on
 // straight lines.
 //
-// The sequence, synchronised by events (the PUMA's motion ends, the Microbo's):
+// The sequence, synchronised by events (the PUMA's motion ends, the Microbo's): a motion of one
+// arm queued with rccl::StartWhen{cell.event(other, m.end())} starts at its first sample after
+// the other's event, without the program waiting in between:
 //   1. The Microbo backs off; the PUMA goes above the board, descends, closes its hand, lifts the
 //      board off the stage and presents it nearer the Microbo.
 //   2. When the presentation has ended, the Microbo probes the pads one by one: above, down to
@@ -43,6 +45,7 @@
 #include <limits>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "rccx/cell/cell.hpp"
@@ -298,12 +301,19 @@ int main(int argc, char** argv) {
   const auto wait = [&](rccl::Manipulator& m, const rccl::Event& e) {
     good = good && reached(m.waitfor(e, kTimeout));
   };
+  // A motion of one arm that starts on an event of the other (Multi-RCCL's synchronisation): it
+  // starts at its robot's first sample after the event, without the program waiting for it.
+  const auto after = [&](std::string_view robot, const rccl::Event& e) {
+    rccl::StartWhen w;
+    w.after = {c.event(robot, e)};
+    return w;
+  };
   puma.set_velocity(80_mm, 45_deg);  // joint moves, too, take their time from these
   microbo.set_velocity(80_mm, 45_deg);
   // The arms start 57 mm apart (both ready poses reach over the board): the Microbo backs off
   // first, and the PUMA sets off once that motion has ended.
-  wait(microbo, microbo.move(m_wait).end());
-  puma.move(p_over);
+  const rccl::Motion back_off = microbo.move(m_wait);
+  puma.move(p_over, after("microbo", back_off.end()));
   puma.set_mode(rccl::Mode::cartesian);
   puma.set_velocity(30_mm, 30_deg);
   const rccl::Motion descend = puma.move(p_grip);
@@ -313,26 +323,27 @@ int main(int argc, char** argv) {
   puma.set_velocity(50_mm, 30_deg);
   puma.move(p_lift);
   const rccl::Motion present = puma.move(p_present);
-  // The Microbo starts only once the board stands still where it is presented.
-  wait(puma, present.end());
-  wait(microbo, microbo.completed());
-  const double presented_s = puma_session.how().time_s;
 
   // --- 2-4. Probe, with the board moving for some pads, and repair one -------------------------
   std::array<PadResult, kPads.size()> results{};
   microbo.set_mode(rccl::Mode::cartesian);
   microbo.set_velocity(40_mm, 45_deg);
+  // The Microbo starts only once the board stands still where it is presented.
+  const rccl::Motion first_above = microbo.move(above[0], after("puma", present.end()));
+  wait(microbo, first_above.start());
+  const double presented_s = puma.report(present).end_s;
+
   rccl::Motion slow{};
   for (std::size_t i = 0; i < kPads.size() && good; ++i) {
-    microbo.move(above[i]);
+    if (i > 0) microbo.move(above[i]);
     const rccl::Motion down = microbo.move(touch[i]);
+    if (i == kStartMovingAfter) {
+      // Once the Microbo has touched TP3, the PUMA carries the board slowly along y.
+      puma.set_velocity(moving_speed_mm_s * 1e-3, 10_deg);
+      slow = puma.move(p_moved, after("microbo", down.end()));
+    }
     wait(microbo, down.end());
     results[i].touched_s = microbo.report(down).end_s;
-    if (i == kStartMovingAfter) {
-      // The Microbo has touched TP3: the PUMA starts carrying the board slowly along y.
-      puma.set_velocity(moving_speed_mm_s * 1e-3, 10_deg);
-      slow = puma.move(p_moved);
-    }
     // The dwell is time let pass, not microbo.dwell(): a queued dwell holds the joints, while a
     // motion to a moving goal that has ended keeps tracking it.
     if (i == kRepairPad) {
@@ -348,9 +359,8 @@ int main(int argc, char** argv) {
   // --- 5. Both back ----------------------------------------------------------------------------
   microbo.set_mode(rccl::Mode::joint);
   const rccl::Motion away = microbo.move(m_wait);
-  wait(microbo, away.end());  // out of the PUMA's way before it turns back
   puma.set_velocity(50_mm, 30_deg);
-  puma.move(p_lift);
+  puma.move(p_lift, after("microbo", away.end()));  // the Microbo out of its way first
   puma.set_velocity(30_mm, 30_deg);
   wait(puma, puma.move(p_grip).end());
   puma.set_hand(false);
