@@ -16,6 +16,7 @@
 //   RCCX_PROPERTY_SEED=n       another seed (the one used is printed)
 //   RCCX_PROPERTY_PROGRAMS=n   how many programs (default 500)
 //   RCCX_PROPERTY_PROGRAM=i    only program i of the seed, its plan and its stops printed
+//   RCCX_PROPERTY_REAL_EVERY=k every k-th program on the real plants (default 10; 1: all)
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -296,6 +297,8 @@ TEST(CellCollisionProperty, ACollisionCourseStopsBothBeforeTheCapsulesMeet) {
   const bool only = only_env != nullptr && *only_env != '\0';
   const std::size_t first = only ? std::strtoull(only_env, nullptr, 0) : 0;
   const std::size_t last = only ? first + 1 : programs;
+  const std::size_t real_every =
+      std::max<std::uint64_t>(env_or("RCCX_PROPERTY_REAL_EVERY", kRealPlantsEvery), 1);
   std::printf("seed %llu (RCCX_PROPERTY_SEED), %zu programs (RCCX_PROPERTY_PROGRAMS)\n",
               static_cast<unsigned long long>(seed), last - first);
 
@@ -330,7 +333,7 @@ TEST(CellCollisionProperty, ACollisionCourseStopsBothBeforeTheCapsulesMeet) {
 
   for (std::size_t i = first; i < last; ++i) {
     cell::CellOptions options;
-    const bool real_plants = i % kRealPlantsEvery == 0;
+    const bool real_plants = i % real_every == 0;
     options.ideal_servo = !real_plants;
     Generator gen(mix(seed, i));
     const Scenario scenario = gen.scenario();
