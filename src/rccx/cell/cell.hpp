@@ -175,6 +175,7 @@ class Cell {
   std::vector<double> last_distance_m_;  ///< per robot pair (a * n + b), the last tick's
   std::vector<std::uint8_t> seen_;       ///< per robot pair: reported this tick
   std::vector<std::size_t> tracked_;     ///< pairs with a finite last distance
+  double widest_margin_m_ = 0.0;         ///< the world's margin with every robot at its top speeds
   std::array<char, rccl::kEventText> message_{};
   std::function<void(std::uint32_t)> observer_;
   std::atomic<std::uint64_t> collision_stops_{0};
