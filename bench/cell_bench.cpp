@@ -22,6 +22,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdint>
+#include <initializer_list>
 #include <memory>
 #include <vector>
 
@@ -40,11 +41,12 @@ std::int64_t process_cpu_ns() {
   return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
 }
 
-void cycle(benchmark::State& state, bool ideal_servo) {
+void cycle(benchmark::State& state, bool ideal_servo, bool one_thread) {
   const auto n = static_cast<std::size_t>(state.range(0));
   const double robots = static_cast<double>(n);
   rccx::cell::CellOptions options;
   options.ideal_servo = ideal_servo;
+  options.one_thread = one_thread;
   rccx::cell::Cell cell(rccx::cell::grid_cell(n, "puma560", kSpacing_m, 1ms), options);
   rccx::cell::start_circles(cell);
   cell.wait_for(2s);  // every robot on its circle, tracking
@@ -84,22 +86,23 @@ benchmark::IterationCount ticks_for(int n) {
   return std::clamp<benchmark::IterationCount>(51'200 / n, 200, 2000);
 }
 
+void add(const char* name, bool ideal_servo, bool one_thread, std::initializer_list<int> ns) {
+  for (const int n : ns) {
+    benchmark::RegisterBenchmark(
+        name, [ideal_servo, one_thread](benchmark::State& s) { cycle(s, ideal_servo, one_thread); })
+        ->Arg(n)
+        ->Iterations(ticks_for(n))
+        ->Unit(benchmark::kMicrosecond)
+        ->UseRealTime();
+  }
+}
+
 void register_cycles() {
-  for (const int n : {1, 2, 8, 32, 128, 256, 512}) {
-    benchmark::RegisterBenchmark("BM_CellCycle", [](benchmark::State& s) { cycle(s, true); })
-        ->Arg(n)
-        ->Iterations(ticks_for(n))
-        ->Unit(benchmark::kMicrosecond)
-        ->UseRealTime();
-  }
-  for (const int n : {1, 8, 128, 256, 512}) {
-    benchmark::RegisterBenchmark("BM_CellCyclePumaPlant",
-                                 [](benchmark::State& s) { cycle(s, false); })
-        ->Arg(n)
-        ->Iterations(ticks_for(n))
-        ->Unit(benchmark::kMicrosecond)
-        ->UseRealTime();
-  }
+  add("BM_CellCycle", true, false, {1, 2, 8, 32, 128, 256, 512});
+  add("BM_CellCyclePumaPlant", false, false, {1, 8, 128, 256, 512});
+  // Both tasks on one thread (CellOptions::one_thread): the cycle's compute on one core.
+  add("BM_CellCycleOneThread", true, true, {1, 2, 8, 32, 128, 256, 512});
+  add("BM_CellCyclePumaPlantOneThread", false, true, {1, 8, 128, 256, 512});
 }
 
 const bool registered = (register_cycles(), true);

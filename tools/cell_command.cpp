@@ -165,6 +165,7 @@ struct LoadArgs {
   std::string spacing = "2.5";
   bool realtime = false;
   bool plant = false;
+  bool one_thread = false;
   bool json = false;
 };
 
@@ -187,12 +188,14 @@ int run_load(const LoadArgs& a) {
   cell::CellOptions options;
   options.clock = a.realtime ? rtc::ClockKind::real_time : rtc::ClockKind::simulated;
   options.ideal_servo = !a.plant;
+  options.one_thread = a.one_thread;
   cell::Cell c(cell::grid_cell(n, a.robot, spacing, period), options);
   if (!a.json) {
     fmt::print("cell-load: {} {} on a {:g} m grid, {} at {:g} ms, {} time, {} s\n", n, a.robot,
                spacing, a.plant ? "each on its plant" : "ideal servos",
                std::chrono::duration<double, std::milli>(period).count(),
                a.realtime ? "real" : "simulated", seconds);
+    if (a.one_thread) fmt::print("both tasks on one thread\n");
   }
   cell::start_circles(c);
   const auto run_for =
@@ -215,6 +218,7 @@ int run_load(const LoadArgs& a) {
     nlohmann::ordered_json j{{"robots", n},
                              {"period_us", period_us},
                              {"realtime", a.realtime},
+                             {"one_thread", a.one_thread},
                              {"ticks", compute.wakeups},
                              {"compute_p50_us", compute.p50_us},
                              {"compute_p99_us", compute.p99_us},
@@ -282,6 +286,9 @@ void add_cell_command(CLI::App& app, int& exit_code) {
                      "Real time (SCHED_FIFO when allowed) instead of simulated time");
   load_cmd->add_flag("--plant", load->plant,
                      "Each robot on the PUMA's PID and plant instead of an ideal servo");
+  load_cmd->add_flag("--one-thread", load->one_thread,
+                     "Both tasks on one thread (no hand-overs between processors; no watchdog "
+                     "for a hung control function)");
   load_cmd->add_flag("--json", load->json, "Print the figures as JSON (us)");
   load_cmd->callback([load, &exit_code] { guarded(exit_code, [&] { return run_load(*load); }); });
 }

@@ -28,6 +28,7 @@ rtc::SessionOptions group_options(const CellModel& m, const CellOptions& o) {
   so.period = m.base_period;
   so.clock = o.clock;
   so.real_time_scheduling = o.real_time_scheduling;
+  so.one_thread = o.one_thread;
   return so;
 }
 

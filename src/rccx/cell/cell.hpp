@@ -59,6 +59,9 @@ struct CellOptions {
   /// Every robot on an ideal servo (hw::IdealArm) instead of its plant (the PUMA's PID on
   /// its dynamics, the Microbo's RCU): for load tests of the cycle itself.
   bool ideal_servo = false;
+  /// Both tasks of the group on one thread (rtc::SessionOptions::one_thread): no hand-overs
+  /// between processors, no watchdog for a hung control function. For load tests.
+  bool one_thread = false;
 };
 
 /// A robot's commanded tool frame in the world at one instant, as the control task publishes it.
