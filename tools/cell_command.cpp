@@ -212,7 +212,13 @@ int run_load(const LoadArgs& a) {
   const rtc::LatencyStats compute = c.group().compute();
   const rtc::LatencyStats wake = c.group().latency();
   std::size_t failed = 0;
-  for (const auto& name : c.robot_names()) failed += c.robot(name).failures().empty() ? 0 : 1;
+  std::string first_failure;  // what went wrong, once: the others are alike as a rule
+  for (const auto& name : c.robot_names()) {
+    const auto& failures = c.robot(name).failures();
+    if (failures.empty()) continue;
+    if (failed++ == 0) first_failure = fmt::format("{}: {}", name, failures.front().text.data());
+  }
+  const rtc::Termination ended = c.session(c.robot_names().front()).termination();
   const double period_us = std::chrono::duration<double, std::micro>(period).count();
   if (a.json) {
     nlohmann::ordered_json j{{"robots", n},
@@ -228,7 +234,8 @@ int run_load(const LoadArgs& a) {
                              {"wakeup_p99_us", wake.p99_us},
                              {"wakeup_max_us", wake.max_us},
                              {"missed_deadlines", wake.missed_deadlines},
-                             {"robots_failed", failed}};
+                             {"robots_failed", failed},
+                             {"first_failure", first_failure}};
     fmt::print("{}\n", j.dump(2));
   } else {
     fmt::print(
@@ -241,7 +248,14 @@ int run_load(const LoadArgs& a) {
           "wake-up latency: p50 {:.0f} us, p99 {:.0f} us, max {:.0f} us; missed deadlines {}\n",
           wake.p50_us, wake.p99_us, wake.max_us, wake.missed_deadlines);
     }
-    if (failed > 0) fmt::print("{} robots' motions failed (see docs/CELL.md)\n", failed);
+    if (failed > 0) {
+      fmt::print("{} robots' motions failed (see docs/CELL.md); the first, {}\n", failed,
+                 first_failure);
+    }
+    if (ended.ended()) {
+      fmt::print("control of {} ended: {} {}\n", c.robot_names().front(),
+                 rtc::to_string(ended.code), ended.detail.data());
+    }
   }
   return failed > 0 ? kFailure : kOk;
 }
