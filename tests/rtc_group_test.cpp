@@ -255,3 +255,64 @@ TEST(SessionGroup, TheCycleHookSeesEveryRobotsChgOfItsTick) {
     }
   }
 }
+
+TEST(SessionGroup, OneThreadRunsTheSameCyclesAsTwoTasks) {
+  // The same commands on both: every robot's measured joints, sample by sample, identical; a
+  // release and a fault in between act the same.
+  const auto run = [](bool one_thread) {
+    Arms a(3);
+    rtc::SessionOptions o = clock_of(10ms);
+    o.one_thread = one_thread;
+    rtc::SessionGroup group(o);
+    std::vector<rtc::Session*> s;
+    for (auto& d : a.drivers) s.push_back(&group.add(*d));
+    auto trace = std::make_shared<std::vector<double>>();  // the control functions' only
+    group.set_cycle_hook([trace](std::uint32_t tick) { trace->push_back(tick); });
+    group.start();
+    for (std::size_t i = 0; i < s.size(); ++i) {
+      s[i]->control(
+          [i](rtc::Control& c) {
+            // Joint 1 at 0.2 rad/s per robot index, one period ahead.
+            c.chg().motion[0] = {rtc::SetMode::posvel,
+                                 c.how().joint[0].range + 0.002 * static_cast<double>(i + 1), 0.0};
+          },
+          [trace](rtc::Control& c) {
+            trace->push_back(c.how().joint[0].q);
+            trace->push_back(c.how().time_s);
+          });
+    }
+    group.wait_for(100ms);
+    s[1]->release();
+    group.wait_for(50ms);
+    a.arms[2]->inject(hw::Fault::joint_not_answering, 1);
+    group.wait_for(50ms);
+    std::vector<double> ends;
+    for (rtc::Session* x : s) ends.push_back(static_cast<double>(x->termination().code));
+    ends.push_back(static_cast<double>(s[0]->how().sample));
+    for (rtc::Session* x : s) x->release();
+    return std::make_pair(*trace, ends);
+  };
+  const auto two = run(false);
+  const auto one = run(true);
+  ASSERT_GT(two.first.size(), 40U);
+  EXPECT_EQ(one.first, two.first);
+  EXPECT_EQ(one.second, two.second);
+  EXPECT_EQ(two.second[2], static_cast<double>(TerminateCode::joint_not_answering));
+}
+
+TEST(SessionGroup, OneThreadStillEndsACycleThatOverruns) {
+  Arms a(2);
+  rtc::SessionOptions o = clock_of(10ms);
+  o.one_thread = true;
+  rtc::SessionGroup group(o);
+  rtc::Session& r0 = group.add(*a.drivers[0]);
+  rtc::Session& r1 = group.add(*a.drivers[1]);
+  group.start();
+  r0.control({}, [](rtc::Control& c) { c.spend(6ms); });
+  r1.control({}, [](rtc::Control& c) { c.spend(6ms); });
+  group.wait_for(50ms);
+  EXPECT_EQ(r0.termination().code, TerminateCode::overrun);
+  EXPECT_EQ(r1.termination().code, TerminateCode::overrun);
+  r0.release();
+  r1.release();
+}

@@ -165,6 +165,7 @@ struct LoadArgs {
   std::string spacing = "2.5";
   bool realtime = false;
   bool plant = false;
+  bool one_thread = false;
   bool json = false;
 };
 
@@ -187,12 +188,14 @@ int run_load(const LoadArgs& a) {
   cell::CellOptions options;
   options.clock = a.realtime ? rtc::ClockKind::real_time : rtc::ClockKind::simulated;
   options.ideal_servo = !a.plant;
+  options.one_thread = a.one_thread;
   cell::Cell c(cell::grid_cell(n, a.robot, spacing, period), options);
   if (!a.json) {
     fmt::print("cell-load: {} {} on a {:g} m grid, {} at {:g} ms, {} time, {} s\n", n, a.robot,
                spacing, a.plant ? "each on its plant" : "ideal servos",
                std::chrono::duration<double, std::milli>(period).count(),
                a.realtime ? "real" : "simulated", seconds);
+    if (a.one_thread) fmt::print("both tasks on one thread\n");
   }
   cell::start_circles(c);
   const auto run_for =
@@ -209,12 +212,19 @@ int run_load(const LoadArgs& a) {
   const rtc::LatencyStats compute = c.group().compute();
   const rtc::LatencyStats wake = c.group().latency();
   std::size_t failed = 0;
-  for (const auto& name : c.robot_names()) failed += c.robot(name).failures().empty() ? 0 : 1;
+  std::string first_failure;  // what went wrong, once: the others are alike as a rule
+  for (const auto& name : c.robot_names()) {
+    const auto& failures = c.robot(name).failures();
+    if (failures.empty()) continue;
+    if (failed++ == 0) first_failure = fmt::format("{}: {}", name, failures.front().text.data());
+  }
+  const rtc::Termination ended = c.session(c.robot_names().front()).termination();
   const double period_us = std::chrono::duration<double, std::micro>(period).count();
   if (a.json) {
     nlohmann::ordered_json j{{"robots", n},
                              {"period_us", period_us},
                              {"realtime", a.realtime},
+                             {"one_thread", a.one_thread},
                              {"ticks", compute.wakeups},
                              {"compute_p50_us", compute.p50_us},
                              {"compute_p99_us", compute.p99_us},
@@ -224,7 +234,8 @@ int run_load(const LoadArgs& a) {
                              {"wakeup_p99_us", wake.p99_us},
                              {"wakeup_max_us", wake.max_us},
                              {"missed_deadlines", wake.missed_deadlines},
-                             {"robots_failed", failed}};
+                             {"robots_failed", failed},
+                             {"first_failure", first_failure}};
     fmt::print("{}\n", j.dump(2));
   } else {
     fmt::print(
@@ -237,7 +248,14 @@ int run_load(const LoadArgs& a) {
           "wake-up latency: p50 {:.0f} us, p99 {:.0f} us, max {:.0f} us; missed deadlines {}\n",
           wake.p50_us, wake.p99_us, wake.max_us, wake.missed_deadlines);
     }
-    if (failed > 0) fmt::print("{} robots' motions failed (see docs/CELL.md)\n", failed);
+    if (failed > 0) {
+      fmt::print("{} robots' motions failed (see docs/CELL.md); the first, {}\n", failed,
+                 first_failure);
+    }
+    if (ended.ended()) {
+      fmt::print("control of {} ended: {} {}\n", c.robot_names().front(),
+                 rtc::to_string(ended.code), ended.detail.data());
+    }
   }
   return failed > 0 ? kFailure : kOk;
 }
@@ -282,6 +300,9 @@ void add_cell_command(CLI::App& app, int& exit_code) {
                      "Real time (SCHED_FIFO when allowed) instead of simulated time");
   load_cmd->add_flag("--plant", load->plant,
                      "Each robot on the PUMA's PID and plant instead of an ideal servo");
+  load_cmd->add_flag("--one-thread", load->one_thread,
+                     "Both tasks on one thread (no hand-overs between processors; no watchdog "
+                     "for a hung control function)");
   load_cmd->add_flag("--json", load->json, "Print the figures as JSON (us)");
   load_cmd->callback([load, &exit_code] { guarded(exit_code, [&] { return run_load(*load); }); });
 }

@@ -14,11 +14,21 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
+// The collision world's margin each tick: the cell's margin plus twice the largest braking
+// allowance of this tick, with headroom, so that the broad phase passes only pairs that may
+// need a stop soon. The headroom keeps a pair that a stop may concern tracked a tick ahead (its
+// last distance tells approaching from moving apart): an allowance at most quadruples in a
+// tick (the speed of a joint at most doubles from a_j P to 2 a_j P, the allowance goes with its
+// square), and one from rest is far below kHeadroom_m.
+constexpr double kHeadroom = 4.0;
+constexpr double kHeadroom_m = 0.05;
+
 rtc::SessionOptions group_options(const CellModel& m, const CellOptions& o) {
   rtc::SessionOptions so;
   so.period = m.base_period;
   so.clock = o.clock;
   so.real_time_scheduling = o.real_time_scheduling;
+  so.one_thread = o.one_thread;
   return so;
 }
 
@@ -110,8 +120,8 @@ Cell::Cell(CellModel model, CellOptions options)
   // The world reports every pair that could need a stop; on_cycle compares each with the
   // margin plus the two robots' allowances at that tick.
   // Two robots' allowances at most, whatever their number: the broad phase stays local.
-  world_ = std::make_unique<CollisionWorld>(std::move(capsules),
-                                            model_.collision_margin_m + 2.0 * widest_allowance_m);
+  widest_margin_m_ = model_.collision_margin_m + 2.0 * widest_allowance_m;
+  world_ = std::make_unique<CollisionWorld>(std::move(capsules), widest_margin_m_);
   const std::size_t n = robots_.size();
   contacts_.resize(n * (n - 1) / 2 + 1);
   last_distance_m_.assign(n * n, kInf);
@@ -353,13 +363,17 @@ void Cell::set_cycle_observer(std::function<void(std::uint32_t)> observer) {
 }
 
 void Cell::on_cycle(std::uint32_t tick) noexcept {
+  double braking_max_m = 0.0;  // the largest allowance of this tick
   for (std::size_t i = 0; i < robots_.size(); ++i) {
     Robot& r = *robots_[i];
     const rccl::TrajectoryGenerator& g = r.manipulator->generator();
     const kin::JointVector& q = g.last_setpoint();
     if (q.size() != model_.robots[i].model.dof()) continue;  // no setpoint yet
     const double t = g.last_setpoint_time_s();
-    if (r.valid && t == r.last_t_s) continue;  // not due this tick: nothing new
+    if (r.valid && t == r.last_t_s) {  // not due this tick: nothing new
+      braking_max_m = std::max(braking_max_m, r.braking_m);
+      continue;
+    }
     // The tool frame, for followers: velocities from the last two published samples.
     ToolSample before;
     r.published.load(before);  // this thread is the only writer: never waits
@@ -385,8 +399,14 @@ void Cell::on_cycle(std::uint32_t tick) noexcept {
     r.braking_m = braking_m(model_.robots[i].model, g.previous_setpoint(), q,
                             g.options().max_acceleration, r.period_s, r.lever_m);
     r.valid = true;
+    braking_max_m = std::max(braking_max_m, r.braking_m);
   }
-  if (options_.collision_checks) check_collisions();
+  if (options_.collision_checks) {
+    world_->set_margin(
+        std::min(widest_margin_m_,
+                 model_.collision_margin_m + 2.0 * (kHeadroom * braking_max_m + kHeadroom_m)));
+    check_collisions();
+  }
   publish_ledgers();
   if (observer_) observer_(tick);
 }

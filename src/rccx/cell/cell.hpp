@@ -63,6 +63,9 @@ struct CellOptions {
   /// user_interrupt), every other robot stops smoothly and holds, its motion failed with the
   /// reason; false: the others go on (their motions that wait on it are cancelled still).
   bool stop_others_on_fault = true;
+  /// Both tasks of the group on one thread (rtc::SessionOptions::one_thread): no hand-overs
+  /// between processors, no watchdog for a hung control function. For load tests.
+  bool one_thread = false;
 };
 
 /// Motions of several robots that start in the same sample (Cell::together).
@@ -212,6 +215,7 @@ class Cell {
   std::vector<double> last_distance_m_;  ///< per robot pair (a * n + b), the last tick's
   std::vector<std::uint8_t> seen_;       ///< per robot pair: reported this tick
   std::vector<std::size_t> tracked_;     ///< pairs with a finite last distance
+  double widest_margin_m_ = 0.0;         ///< the world's margin with every robot at its top speeds
   std::array<char, rccl::kEventText> message_{};
   std::function<void(std::uint32_t)> observer_;
   std::atomic<std::uint64_t> collision_stops_{0};

@@ -58,6 +58,12 @@ bool CollisionWorld::set_configuration(std::size_t robot, const kin::JointVector
   return robot < robots_.size() && robots_[robot].update(q);
 }
 
+bool CollisionWorld::set_margin(double margin_m) noexcept {
+  if (!std::isfinite(margin_m) || margin_m < 0.0) return false;
+  margin_m_ = margin_m;
+  return true;
+}
+
 void CollisionWorld::sort_boxes() noexcept {
   if (order_.empty()) return;
   // Boxes as they are now, and the spread of their centres (2x, which does not matter).

@@ -69,6 +69,10 @@ class CollisionWorld {
 
   [[nodiscard]] std::size_t size() const noexcept { return robots_.size(); }
   [[nodiscard]] double margin_m() const noexcept { return margin_m_; }
+  /// Changes the margin (m) for the next calls: a cell narrows it to what its robots' speeds
+  /// need at this tick, so that the broad phase passes fewer pairs. False, and nothing changed,
+  /// for a negative or non-finite margin.
+  bool set_margin(double margin_m) noexcept;
   [[nodiscard]] const RobotCapsules& robot(std::size_t i) const noexcept { return robots_[i]; }
   [[nodiscard]] const CheckStats& last_stats() const noexcept { return stats_; }
   /// The axis the broad phase sweeps along (0 x, 1 y, 2 z).

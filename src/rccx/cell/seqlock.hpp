@@ -1,8 +1,10 @@
 // A value one thread writes and any thread reads without a lock (a sequence lock): the writer
 // makes the counter odd, writes, makes it even; a reader copies and retries when the counter
 // was odd or changed meanwhile. Neither side blocks or allocates; the writer never waits. The
-// value is kept in relaxed atomic words so that the racing copy is defined behaviour (and
-// ThreadSanitizer sees no race); the fences order them against the counter.
+// value is kept in atomic words so that the racing copy is defined behaviour (and
+// ThreadSanitizer sees no race); release stores and acquire loads of the words order them
+// against the counter (plain moves on x86; fences would do as well, but ThreadSanitizer does
+// not model them).
 //
 // What the cell uses to hand one robot's tool frame, written by the control task each sample,
 // to another robot's trajectory generator (same thread) and to the planning level (move()).
@@ -27,8 +29,8 @@ class SeqLock {
     std::memcpy(w.data(), &value, sizeof(T));
     const std::uint64_t s = seq_.load(std::memory_order_relaxed);
     seq_.store(s + 1, std::memory_order_relaxed);
-    std::atomic_thread_fence(std::memory_order_release);  // odd before any word
-    for (std::size_t i = 0; i < kWords; ++i) words_[i].store(w[i], std::memory_order_relaxed);
+    // Release: odd before any word.
+    for (std::size_t i = 0; i < kWords; ++i) words_[i].store(w[i], std::memory_order_release);
     seq_.store(s + 2, std::memory_order_release);  // every word before even
   }
 
@@ -38,8 +40,8 @@ class SeqLock {
     for (;;) {
       const std::uint64_t s0 = seq_.load(std::memory_order_acquire);
       if ((s0 & 1U) != 0) continue;  // a store is under way: it takes a few ns
-      for (std::size_t i = 0; i < kWords; ++i) w[i] = words_[i].load(std::memory_order_relaxed);
-      std::atomic_thread_fence(std::memory_order_acquire);  // the words before the re-check
+      // Acquire: the words before the re-check.
+      for (std::size_t i = 0; i < kWords; ++i) w[i] = words_[i].load(std::memory_order_acquire);
       if (seq_.load(std::memory_order_relaxed) != s0) continue;
       if (s0 == 0) return false;
       std::memcpy(static_cast<void*>(&out), w.data(), sizeof(T));

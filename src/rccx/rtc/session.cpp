@@ -147,6 +147,15 @@ struct Session::Clock {
   void watchdog(std::uint32_t k, std::int64_t tick_ns) noexcept;
   void control_task() noexcept;
   void control_cycle(std::uint32_t k) noexcept;
+  /// Pieces of a control cycle: every f1 of tick k; every f2 and the cycle hook, then the
+  /// watchdog kick.
+  void run_f1s(std::uint32_t k) noexcept;
+  void finish_cycle(std::uint32_t k) noexcept;
+  /// The communication task's side after the f1s: every Chg of tick k taken (or, not
+  /// `in_time`, control ended with overrun), every How published.
+  void take_chgs(std::uint32_t k, bool in_time) noexcept;
+  /// A robot of tick k whose control still runs.
+  [[nodiscard]] static bool in_cycle(const Session* s, std::uint32_t k) noexcept;
   void step_simulated_sample();
 };
 
@@ -297,10 +306,10 @@ void Session::Clock::start() {
   t0_ns = monotonic_ns();
   running = true;
   communication_thread = std::thread([this] { communication_task(); });
-  control_thread = std::thread([this] { control_task(); });
+  if (!options.one_thread) control_thread = std::thread([this] { control_task(); });
   if (options.clock == ClockKind::real_time && options.real_time_scheduling) {
     try_real_time_scheduling(communication_thread, 80);
-    try_real_time_scheduling(control_thread, 79);
+    if (control_thread.joinable()) try_real_time_scheduling(control_thread, 79);
   }
   // The first How, so that how() means something before the first wait.
   if (simulated()) step_simulated_sample();
@@ -312,7 +321,7 @@ void Session::Clock::stop_tasks() {
   ring(comm_bell);
   ring(control_bell);
   communication_thread.join();
-  control_thread.join();
+  if (control_thread.joinable()) control_thread.join();
   stopped = true;
 }
 
@@ -634,7 +643,21 @@ void Session::Clock::communication_task() noexcept {
     for (Session* s : sessions) {
       if (s->communication_cycle(*s->comm_, k, tick_ns)) handed = true;
     }
-    if (handed) {
+    if (handed && options.one_thread) {
+      // The control cycle here, in the order of the two tasks: every f1, every Chg applied,
+      // every f2. Busy before the f1s look at the phases, as control_task() is.
+      handed_tick_ns.store(tick_ns, std::memory_order_relaxed);
+      last_published = k;
+      last_published_tick_ns = tick_ns;
+      control_busy.store(true, std::memory_order_seq_cst);
+      how_ready.store(k, std::memory_order_release);
+      run_f1s(k);
+      chg_ready.store(k, std::memory_order_release);
+      take_chgs(k, true);
+      chg_taken.store(k, std::memory_order_release);
+      finish_cycle(k);
+      control_busy.store(false, std::memory_order_seq_cst);
+    } else if (handed) {
       // Hand How over for every robot at once; wait for the Chg their f1s leave (at most until
       // the next tick).
       handed_tick_ns.store(tick_ns, std::memory_order_relaxed);
@@ -656,19 +679,7 @@ void Session::Clock::communication_task() noexcept {
         }
         wait_while(comm_bell, seen, deadline);
       }
-      for (Session* s : sessions) {
-        if (s->shared_->in_cycle.load(std::memory_order_relaxed) != k) continue;
-        if (!s->comm_->ended && s->shared_->phase.load(std::memory_order_seq_cst) == kControlling) {
-          if (in_time) {
-            s->take_chg(*s->comm_);
-          } else {
-            std::array<char, kMessageCapacity> d;
-            format_text(d, "f1 of sample {} did not hand Chg over within its period", k);
-            s->end_control(*s->comm_, TerminateCode::overrun, 0, d.data());
-          }
-        }
-        s->shared_->latest.publish(s->comm_->how);  // with the flags the Chg set
-      }
+      take_chgs(k, in_time);
       chg_taken.store(k, std::memory_order_release);
       ring(control_bell);
     } else {
@@ -676,6 +687,22 @@ void Session::Clock::communication_task() noexcept {
     }
     comm_done.store(k, std::memory_order_release);
     ring(planning_bell);
+  }
+}
+
+void Session::Clock::take_chgs(std::uint32_t k, bool in_time) noexcept {
+  for (Session* s : sessions) {
+    if (s->shared_->in_cycle.load(std::memory_order_relaxed) != k) continue;
+    if (!s->comm_->ended && s->shared_->phase.load(std::memory_order_seq_cst) == kControlling) {
+      if (in_time) {
+        s->take_chg(*s->comm_);
+      } else {
+        std::array<char, kMessageCapacity> d;
+        format_text(d, "f1 of sample {} did not hand Chg over within its period", k);
+        s->end_control(*s->comm_, TerminateCode::overrun, 0, d.data());
+      }
+    }
+    s->shared_->latest.publish(s->comm_->how);  // with the flags the Chg set
   }
 }
 
@@ -998,14 +1025,19 @@ void Session::Clock::control_task() noexcept {
   }
 }
 
-void Session::Clock::control_cycle(std::uint32_t k) noexcept {
-  const auto in = [k](const Session* s) {
-    return s->shared_->in_cycle.load(std::memory_order_relaxed) == k &&
-           s->shared_->phase.load(std::memory_order_seq_cst) == kControlling;
-  };
+bool Session::Clock::in_cycle(const Session* s, std::uint32_t k) noexcept {
+  return s->shared_->in_cycle.load(std::memory_order_relaxed) == k &&
+         s->shared_->phase.load(std::memory_order_seq_cst) == kControlling;
+}
+
+void Session::Clock::run_f1s(std::uint32_t k) noexcept {
   for (Session* s : sessions) {
-    if (in(s)) s->run_f1(k);
+    if (in_cycle(s, k)) s->run_f1(k);
   }
+}
+
+void Session::Clock::control_cycle(std::uint32_t k) noexcept {
+  run_f1s(k);
   chg_ready.store(k, std::memory_order_release);
   ring(comm_bell);
   for (;;) {
@@ -1014,16 +1046,20 @@ void Session::Clock::control_cycle(std::uint32_t k) noexcept {
     if (stop.load(std::memory_order_acquire)) return;
     wait_while(control_bell, seen);
   }
+  finish_cycle(k);
+}
+
+void Session::Clock::finish_cycle(std::uint32_t k) noexcept {
   std::int64_t spent_ns = 0;
   for (Session* s : sessions) {
-    if (in(s)) spent_ns += s->run_f2();
+    if (in_cycle(s, k)) spent_ns += s->run_f2();
   }
   if (cycle_hook) {
     try {
       cycle_hook(k);
     } catch (...) {
       for (Session* s : sessions) {
-        if (in(s)) s->request_termination(TerminateCode::control_exception, 0);
+        if (in_cycle(s, k)) s->request_termination(TerminateCode::control_exception, 0);
       }
     }
   }

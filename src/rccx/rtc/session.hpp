@@ -56,6 +56,12 @@ struct SessionOptions {
   std::chrono::milliseconds hang_timeout{std::chrono::seconds(5)};
   /// Real time only: record wake-up latency of the communication task.
   bool measure_latency = true;
+  /// Both tasks on one thread: the communication task runs each tick's control cycle itself
+  /// between handing How over and taking Chg (the same order, f2 after Chg is applied), with
+  /// no hand-over between threads or processors. For loads of many robots on one core; there
+  /// is no watchdog then for a control function that hangs (a cycle longer than the period
+  /// makes the next ticks late, counted as missed), so not for real arms.
+  bool one_thread = false;
 };
 
 /// A misuse of the session or a bad option: says what to do instead.
