@@ -242,7 +242,6 @@ rccl::WaitResult Cell::waitfor(const std::vector<rccl::EventGate>& gates,
 void Cell::publish_ledgers() noexcept {
   for (auto& rp : robots_) {
     Robot& r = *rp;
-    r.ledger.copy_from(r.manipulator->generator().ledger());
     const bool controlling = r.session->controlling();
     if (controlling) {
       r.was_controlling = true;
@@ -367,6 +366,7 @@ void Cell::on_cycle(std::uint32_t tick) noexcept {
   for (std::size_t i = 0; i < robots_.size(); ++i) {
     Robot& r = *robots_[i];
     const rccl::TrajectoryGenerator& g = r.manipulator->generator();
+    r.ledger.copy_from(g.ledger());  // for the gates of the next tick (publish_ledgers)
     const kin::JointVector& q = g.last_setpoint();
     if (q.size() != model_.robots[i].model.dof()) continue;  // no setpoint yet
     const double t = g.last_setpoint_time_s();

@@ -288,7 +288,6 @@ class TrajectoryGenerator {
   std::atomic<bool> halt_requested_{false};
   bool stop_requested_ = false;  ///< request_stop(): same thread as step()
   Text stop_text_{};
-  MotionLedger ledger_;
   std::array<SegmentReport, kReports> reports_{};
 
   // Loop state.
@@ -300,6 +299,7 @@ class TrajectoryGenerator {
   Transition tr_;
   Halt halt_;
   kin::JointVector last_q_, prev_q_;  ///< the last two setpoints
+  MotionLedger ledger_;               ///< beside last_q_: a cell's cycle hook reads both every tick
   double last_t_ = 0.0;
   Pose pose_;  ///< cur_'s frames this sample, when it is a Cartesian segment outside transitions
   bool pose_valid_ = false;
