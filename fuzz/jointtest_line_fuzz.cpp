@@ -18,8 +18,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   for (const auto& model : robots) {
     for (std::size_t joint = 0; joint < model.dof(); ++joint) {
       try {
-        const rccx::tools::JointtestLine c =
-            rccx::tools::parse_jointtest_line(line, model, joint);
+        const rccx::tools::JointtestLine c = rccx::tools::parse_jointtest_line(line, model, joint);
         if (c.joint >= model.dof() || !std::isfinite(c.value) || c.duration.count() < 0) {
           __builtin_trap();
         }

@@ -11,8 +11,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::string_view text(reinterpret_cast<const char*>(data), size);
   try {
     const auto all = rccx::rccl::parse_position_export(text, "fuzz");
-    const auto again = rccx::rccl::parse_position_export(
-        rccx::rccl::position_export_json(all), "fuzz round trip");
+    const auto again =
+        rccx::rccl::parse_position_export(rccx::rccl::position_export_json(all), "fuzz round trip");
     if (again.size() != all.size()) std::abort();
   } catch (const rccx::rccl::PositionExportError&) {
   }
