@@ -99,10 +99,10 @@ void add(const char* name, bool ideal_servo, bool one_thread, std::initializer_l
 
 void register_cycles() {
   add("BM_CellCycle", true, false, {1, 2, 8, 32, 128, 256, 512});
-  add("BM_CellCyclePumaPlant", false, false, {1, 8, 128, 256, 512});
+  add("BM_CellCyclePumaPlant", false, false, {1, 2, 8, 32, 128, 256, 512});
   // Both tasks on one thread (CellOptions::one_thread): the cycle's compute on one core.
   add("BM_CellCycleOneThread", true, true, {1, 2, 8, 32, 128, 256, 512});
-  add("BM_CellCyclePumaPlantOneThread", false, true, {1, 8, 128, 256, 512});
+  add("BM_CellCyclePumaPlantOneThread", false, true, {1, 2, 8, 32, 128, 256, 512});
 }
 
 const bool registered = (register_cycles(), true);
