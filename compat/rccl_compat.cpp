@@ -358,6 +358,17 @@ int bad_handle(const char* call) {
               Say::print);
 }
 
+/// A robot's position or transform, or NULL (with the error) for a bad handle.
+template <class T>
+T* member_of(const MANIP* m, const char* call, T* rccl_manip::*member) {
+  rccl_manip* r = known(m);
+  if (r == nullptr) {
+    bad_handle(call);
+    return nullptr;
+  }
+  return r->*member;
+}
+
 TRSF_PTR keep_transform(rc::TransformPtr t) {
   auto box = std::make_unique<rccl_trsf>(rccl_trsf{std::move(t)});
   TRSF_PTR p = box.get();
@@ -1000,39 +1011,19 @@ int mnp_completed(const MANIP* m) {
 }
 
 POS_PTR mnp_park(MANIP* m) {
-  rccl_manip* r = known(m);
-  if (r == nullptr) {
-    bad_handle("mnp_park");
-    return nullptr;
-  }
-  return r->park;
+  return member_of(m, "mnp_park", &rccl_manip::park);
 }
 
 TRSF_PTR mnp_tool(MANIP* m) {
-  rccl_manip* r = known(m);
-  if (r == nullptr) {
-    bad_handle("mnp_tool");
-    return nullptr;
-  }
-  return r->tool;
+  return member_of(m, "mnp_tool", &rccl_manip::tool);
 }
 
 TRSF_PTR mnp_base_inv(MANIP* m) {
-  rccl_manip* r = known(m);
-  if (r == nullptr) {
-    bad_handle("mnp_base_inv");
-    return nullptr;
-  }
-  return r->base_inv;
+  return member_of(m, "mnp_base_inv", &rccl_manip::base_inv);
 }
 
 TRSF_PTR mnp_tool_frame(MANIP* leader) {
-  rccl_manip* r = known(leader);
-  if (r == nullptr) {
-    bad_handle("mnp_tool_frame");
-    return nullptr;
-  }
-  return r->tool_frame;
+  return member_of(leader, "mnp_tool_frame", &rccl_manip::tool_frame);
 }
 
 }  // extern "C"

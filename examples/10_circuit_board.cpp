@@ -301,19 +301,12 @@ int main(int argc, char** argv) {
   const auto wait = [&](rccl::Manipulator& m, const rccl::Event& e) {
     good = good && reached(m.waitfor(e, kTimeout));
   };
-  // A motion of one arm that starts on an event of the other (Multi-RCCL's synchronisation): it
-  // starts at its robot's first sample after the event, without the program waiting for it.
-  const auto after = [&](std::string_view robot, const rccl::Event& e) {
-    rccl::StartWhen w;
-    w.after = {c.event(robot, e)};
-    return w;
-  };
   puma.set_velocity(80_mm, 45_deg);  // joint moves, too, take their time from these
   microbo.set_velocity(80_mm, 45_deg);
   // The arms start 57 mm apart (both ready poses reach over the board): the Microbo backs off
   // first, and the PUMA sets off once that motion has ended.
   const rccl::Motion back_off = microbo.move(m_wait);
-  puma.move(p_over, after("microbo", back_off.end()));
+  puma.move(p_over, c.after("microbo", back_off.end()));
   puma.set_mode(rccl::Mode::cartesian);
   puma.set_velocity(30_mm, 30_deg);
   const rccl::Motion descend = puma.move(p_grip);
@@ -329,7 +322,7 @@ int main(int argc, char** argv) {
   microbo.set_mode(rccl::Mode::cartesian);
   microbo.set_velocity(40_mm, 45_deg);
   // The Microbo starts only once the board stands still where it is presented.
-  const rccl::Motion first_above = microbo.move(above[0], after("puma", present.end()));
+  const rccl::Motion first_above = microbo.move(above[0], c.after("puma", present.end()));
   wait(microbo, first_above.start());
   const double presented_s = puma.report(present).end_s;
 
@@ -340,7 +333,7 @@ int main(int argc, char** argv) {
     if (i == kStartMovingAfter) {
       // Once the Microbo has touched TP3, the PUMA carries the board slowly along y.
       puma.set_velocity(moving_speed_mm_s * 1e-3, 10_deg);
-      slow = puma.move(p_moved, after("microbo", down.end()));
+      slow = puma.move(p_moved, c.after("microbo", down.end()));
     }
     wait(microbo, down.end());
     results[i].touched_s = microbo.report(down).end_s;
@@ -360,7 +353,7 @@ int main(int argc, char** argv) {
   microbo.set_mode(rccl::Mode::joint);
   const rccl::Motion away = microbo.move(m_wait);
   puma.set_velocity(50_mm, 30_deg);
-  puma.move(p_lift, after("microbo", away.end()));  // the Microbo out of its way first
+  puma.move(p_lift, c.after("microbo", away.end()));  // the Microbo out of its way first
   puma.set_velocity(30_mm, 30_deg);
   wait(puma, puma.move(p_grip).end());
   puma.set_hand(false);

@@ -88,18 +88,12 @@ TEST(CellSync, ChainedEventsRunInTheOrderAskedSampleExact) {
   // D (Microbo) starts when C has ended. The Microbo is stepped after the PUMA in a tick (B, D)
   // and the PUMA before the Microbo (C): both orders.
   const rccl::Motion a = puma.move(world_position(*c, "puma", "A", down_at(kPumaAt + kDy)));
-  rccl::StartWhen after_a;
-  after_a.after = {c->event("puma", a.end())};
-  const rccl::Motion b =
-      microbo.move(world_position(*c, "microbo", "B", down_at(kMicroboAt + kDy)), after_a);
-  rccl::StartWhen after_b_started;
-  after_b_started.after = {c->event("microbo", b.start())};
+  const rccl::Motion b = microbo.move(world_position(*c, "microbo", "B", down_at(kMicroboAt + kDy)),
+                                      c->after("puma", a.end()));
   const rccl::Motion cc =
-      puma.move(world_position(*c, "puma", "C", down_at(kPumaAt)), after_b_started);
-  rccl::StartWhen after_c;
-  after_c.after = {c->event("puma", cc.end())};
-  const rccl::Motion d =
-      microbo.move(world_position(*c, "microbo", "D", down_at(kMicroboAt)), after_c);
+      puma.move(world_position(*c, "puma", "C", down_at(kPumaAt)), c->after("microbo", b.start()));
+  const rccl::Motion d = microbo.move(world_position(*c, "microbo", "D", down_at(kMicroboAt)),
+                                      c->after("puma", cc.end()));
 
   ASSERT_EQ(c->waitfor({c->event("microbo", d.end())}, 30s), rccl::WaitResult::reached)
       << failures_of(puma) << failures_of(microbo);
@@ -132,9 +126,8 @@ TEST(CellSync, AGatedMotionWhoseGateIsOpenJoinsItsPredecessorWithoutStopping) {
   ASSERT_EQ(microbo.waitfor(m.end(), 20s), rccl::WaitResult::reached);
   // The PUMA's second motion waits for an event that has happened: it blends in as usual.
   const rccl::Motion a = puma.move(world_position(*c, "puma", "A", down_at(kPumaAt + kDy)));
-  rccl::StartWhen w;
-  w.after = {c->event("microbo", m.end())};
-  const rccl::Motion b = puma.move(world_position(*c, "puma", "B", down_at(kPumaAt)), w);
+  const rccl::Motion b =
+      puma.move(world_position(*c, "puma", "B", down_at(kPumaAt)), c->after("microbo", m.end()));
   ASSERT_EQ(puma.waitfor(b.end(), 20s), rccl::WaitResult::reached) << failures_of(puma);
   Events ep;
   ep.take(puma);
@@ -205,10 +198,8 @@ TEST(CellSync, AMotionWaitingOnAFailedMotionIsCancelledWithTheReason) {
   rccl::Manipulator& puma = c->robot("puma");
   rccl::Manipulator& microbo = c->robot("microbo");
   const rccl::Motion a = puma.move(world_position(*c, "puma", "A", down_at(kPumaAt + kDy)));
-  rccl::StartWhen w;
-  w.after = {c->event("puma", a.end())};
-  const rccl::Motion b =
-      microbo.move(world_position(*c, "microbo", "B", down_at(kMicroboAt + kDy)), w);
+  const rccl::Motion b = microbo.move(world_position(*c, "microbo", "B", down_at(kMicroboAt + kDy)),
+                                      c->after("puma", a.end()));
   const rccl::Motion b2 = microbo.move(world_position(*c, "microbo", "B2", down_at(kMicroboAt)));
   c->wait_for(100ms);
   puma.halt();  // A fails
@@ -231,10 +222,8 @@ TEST(CellSync, AFaultCancelsTheMotionsWaitingOnTheFailedRobot) {
   rccl::Manipulator& puma = c->robot("puma");
   rccl::Manipulator& microbo = c->robot("microbo");
   const rccl::Motion a = puma.move(world_position(*c, "puma", "A", down_at(kPumaAt + kDy)));
-  rccl::StartWhen w;
-  w.after = {c->event("puma", a.end())};
-  const rccl::Motion b =
-      microbo.move(world_position(*c, "microbo", "B", down_at(kMicroboAt + kDy)), w);
+  const rccl::Motion b = microbo.move(world_position(*c, "microbo", "B", down_at(kMicroboAt + kDy)),
+                                      c->after("puma", a.end()));
   // A joint start with the PUMA that it will never reach.
   const cell::Together go = c->together({"puma", "microbo"});
   c->wait_for(100ms);
@@ -285,9 +274,9 @@ TEST(CellSync, AJointStartWhoseOtherPartIsCancelledIsCancelled) {
 TEST(CellSync, BadStartConditionsAreRefusedAtTheCall) {
   const auto c = cell_at_rest();
   rccl::Manipulator& puma = c->robot("puma");
+  // Its own live ledger, a motion not queued yet: it would wait for itself.
   rccl::StartWhen own;
-  own.after = {c->event("puma", rccl::Motion{puma.last_queued() + 1}.end())};
-  own.after[0].ledger = &puma.generator().ledger();  // its own live ledger: a deadlock
+  own.after = {puma.gate(rccl::Motion{puma.last_queued() + 1}.end())};
   EXPECT_THROW((void)puma.move(puma.park(), own), rccl::MotionError);
   rccl::StartWhen many;
   many.after.assign(rccl::StartWhen::kMaxGates + 1,
@@ -313,13 +302,10 @@ TEST(CellSync, AChainedStartIsTheNextSampleWhicheverRobotIsSteppedFirst) {
   rccl::Manipulator& puma = c.robot("puma");
   rccl::Manipulator& microbo = c.robot("microbo");
   const rccl::Motion a = puma.move(world_position(c, "puma", "A", down_at(kPumaAt + kDy)));
-  rccl::StartWhen after_a;
-  after_a.after = {c.event("puma", a.end())};
-  const rccl::Motion b =
-      microbo.move(world_position(c, "microbo", "B", down_at(kMicroboAt + kDy)), after_a);
-  rccl::StartWhen after_b;
-  after_b.after = {c.event("microbo", b.end())};
-  const rccl::Motion a2 = puma.move(world_position(c, "puma", "A2", down_at(kPumaAt)), after_b);
+  const rccl::Motion b = microbo.move(world_position(c, "microbo", "B", down_at(kMicroboAt + kDy)),
+                                      c.after("puma", a.end()));
+  const rccl::Motion a2 =
+      puma.move(world_position(c, "puma", "A2", down_at(kPumaAt)), c.after("microbo", b.end()));
   ASSERT_EQ(c.waitfor({c.event("puma", a2.end())}, 60s), rccl::WaitResult::reached)
       << failures_of(puma) << failures_of(microbo);
   Events ep, em;

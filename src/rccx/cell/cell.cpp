@@ -166,6 +166,12 @@ rccl::EventGate Cell::event(std::string_view robot, const rccl::Event& e) {
   return g;
 }
 
+rccl::StartWhen Cell::after(std::string_view robot, const rccl::Event& e) {
+  rccl::StartWhen w;
+  w.after.push_back(event(robot, e));
+  return w;
+}
+
 Together Cell::together(const std::vector<std::string>& robots, bool end_together) {
   if (robots.empty() || robots.size() > rccl::Rendezvous::kMaxParticipants) {
     throw std::invalid_argument(fmt::format("a joint start takes 1 to {} robots (got {})",

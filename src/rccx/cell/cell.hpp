@@ -140,6 +140,9 @@ class Cell {
   /// happened in, whatever the robots' order. Event::completed() means the last motion `robot`
   /// has queued so far. Throws like robot(); rccl::MotionError for a position's end.
   [[nodiscard]] rccl::EventGate event(std::string_view robot, const rccl::Event& e);
+  /// What move() / dwell() take to start once `robot`'s event has happened:
+  /// `microbo.move(p, cell.after("puma", m.end()))`.
+  [[nodiscard]] rccl::StartWhen after(std::string_view robot, const rccl::Event& e);
   /// A joint start: one motion of each of `robots` (each queued with Together::when) starts in
   /// the same sample, the first all of them are sampled in once every one is at rest and
   /// ready; with `end_together`, all end (come to rest) in the same sample too, the faster
