@@ -433,8 +433,17 @@ void Cell::check_collisions() noexcept {
     last[pair] = c.distance_m;
     if (!a.valid || !b.valid) continue;
     const double limit = model_.collision_margin_m + a.braking_m + b.braking_m;
-    // Only while they approach: two arms stopped close together may still move apart.
-    if (!(c.distance_m < limit) || !(c.distance_m < before)) continue;
+    // Only while they approach: two arms stopped close together may still move apart. A change
+    // at rounding level (two arms standing, their setpoints re-solved) is not an approach.
+    constexpr double kApproach_m = 1e-12;
+    if (!(c.distance_m < limit) || !(c.distance_m < before - kApproach_m)) continue;
+    // Two arms whose setpoints stand still have nothing to stop (a pair first reported while
+    // both stand comes "from infinitely far").
+    const auto standing = [](const Robot& r) {
+      const rccl::TrajectoryGenerator& g = r.manipulator->generator();
+      return g.last_setpoint() == g.previous_setpoint();
+    };
+    if (standing(a) && standing(b)) continue;
     try {
       const auto r = fmt::format_to_n(
           message_.data(), message_.size() - 1,
