@@ -16,6 +16,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <map>
 #include <memory>
 #include <stdexcept>
@@ -731,7 +732,12 @@ int rccl_cell_open(const char* cell_file) {
     if (path.empty()) {
       if (const char* env = std::getenv("RCCX_CELL"); env != nullptr) path = env;
     }
-    if (path.empty()) path = RCCX_DEFAULT_CELL;
+    if (path.empty()) {
+      // The source tree's (a build), else the installed copy.
+      std::error_code ec;
+      path = std::filesystem::exists(RCCX_DEFAULT_CELL, ec) ? RCCX_DEFAULT_CELL
+                                                              : RCCX_INSTALLED_CELL;
+    }
     try {
       s.cell = rccx::cell::Cell::load(path);
     } catch (const rccx::cell::CellFileError& e) {
