@@ -11,6 +11,7 @@
 #include <set>
 
 #include "rccx/io/file.hpp"
+#include "rccx/io/json_reader.hpp"
 #include "rccx/io/parse.hpp"
 #include "rccx/kinematics/kinematics.hpp"
 #include "rccx/math/units.hpp"
@@ -221,90 +222,7 @@ namespace {
 
 // ---- The file ----
 
-// Reads a JSON object key by key so that every error names where it is, and so that an unknown
-// key (a typo such as "base_period_s") is refused instead of silently ignored (the robot
-// files' reader, robot_model.cpp, with this layer's error type).
-class Reader {
- public:
-  Reader(const json& object, std::string where) : object_(object), where_(std::move(where)) {
-    if (!object_.is_object()) fail("expected an object");
-  }
-
-  [[noreturn]] void fail(const std::string& what) const {
-    throw CellFileError(fmt::format("{}: {}", where_, what));
-  }
-
-  bool has(const char* key) {
-    used_.insert(key);
-    return object_.contains(key);
-  }
-
-  const json& get(const char* key) {
-    if (!has(key)) fail(fmt::format("missing \"{}\"", key));
-    return object_.at(key);
-  }
-
-  std::string string(const char* key) {
-    const json& v = get(key);
-    if (!v.is_string()) fail(fmt::format("\"{}\" must be a string", key));
-    return v.get<std::string>();
-  }
-
-  std::string string_or(const char* key) { return has(key) ? string(key) : std::string(); }
-
-  /// A finite number no larger than `limit` in magnitude.
-  double number(const json& v, const std::string& what, double limit) const {
-    if (!v.is_number()) fail(fmt::format("{} must be a number", what));
-    const double d = v.get<double>();
-    if (!std::isfinite(d)) fail(fmt::format("{} must be finite", what));
-    if (std::abs(d) > limit) {
-      fail(fmt::format("{} is {:g}; at most {:g} in magnitude", what, d, limit));
-    }
-    return d;
-  }
-
-  double number(const char* key, double limit) {
-    return number(get(key), fmt::format("\"{}\"", key), limit);
-  }
-
-  /// `count` numbers, each as number().
-  template <std::size_t N>
-  std::array<double, N> numbers(const char* key, double limit) {
-    const json& v = get(key);
-    if (!v.is_array() || v.size() != N) fail(fmt::format("\"{}\" must be {} numbers", key, N));
-    std::array<double, N> out{};
-    for (std::size_t i = 0; i < N; ++i) {
-      out[i] = number(v[i], fmt::format("\"{}\" [{}]", key, i + 1), limit);
-    }
-    return out;
-  }
-
-  /// A whole number in [lo, hi].
-  std::int64_t integer(const char* key, std::int64_t lo, std::int64_t hi) {
-    const json& v = get(key);
-    if (!v.is_number_integer()) fail(fmt::format("\"{}\" must be a whole number", key));
-    const bool fits = v.is_number_unsigned()
-                          ? v.get<std::uint64_t>() <= static_cast<std::uint64_t>(hi) &&
-                                static_cast<std::int64_t>(v.get<std::uint64_t>()) >= lo
-                          : v.get<std::int64_t>() >= lo && v.get<std::int64_t>() <= hi;
-    if (!fits) fail(fmt::format("\"{}\" is {}; {} to {}", key, v.dump(), lo, hi));
-    return v.is_number_unsigned() ? static_cast<std::int64_t>(v.get<std::uint64_t>())
-                                  : v.get<std::int64_t>();
-  }
-
-  void no_unknown_keys() const {
-    for (const auto& item : object_.items()) {
-      if (!used_.contains(item.key())) fail(fmt::format("unknown key \"{}\"", item.key()));
-    }
-  }
-
-  const std::string& where() const { return where_; }
-
- private:
-  const json& object_;
-  std::string where_;
-  std::set<std::string> used_;
-};
+using Reader = io::JsonObjectReader<CellFileError>;
 
 /// {"xyz_m": [x, y, z], "rpy_deg": [roll, pitch, yaw]} (Paul's RPY: Rot(z, roll) Rot(y, pitch)
 /// Rot(x, yaw); rpy_deg may be left out) or {"rows_m": [12 numbers, row by row]}.

@@ -11,6 +11,7 @@
 
 #include "rccx/hw/arm_base.hpp"
 #include "rccx/hw/rcu.hpp"
+#include "rccx/io/json_reader.hpp"
 
 namespace rccx::hw {
 
@@ -18,83 +19,11 @@ namespace {
 
 using nlohmann::json;
 
-class Reader {
+/// The RCU section's numbers are counts, gains and rates of their own sizes: no magnitude bound.
+class Reader : public io::JsonObjectReader<std::invalid_argument> {
  public:
-  Reader(const json& object, std::string where) : object_(object), where_(std::move(where)) {
-    if (!object_.is_object()) fail("expected an object");
-  }
-
-  [[noreturn]] void fail(const std::string& what) const {
-    throw std::invalid_argument(fmt::format("{}: {}", where_, what));
-  }
-
-  bool has(const std::string& key) {
-    used_.insert(key);
-    return object_.contains(key);
-  }
-
-  const json& get(const std::string& key) {
-    if (!has(key)) fail(fmt::format("missing \"{}\"", key));
-    return object_.at(key);
-  }
-
-  double number(const std::string& key) {
-    const json& v = get(key);
-    if (!v.is_number()) fail(fmt::format("\"{}\" must be a number", key));
-    const double d = v.get<double>();
-    if (!std::isfinite(d)) fail(fmt::format("\"{}\" must be finite", key));
-    return d;
-  }
-  double number_or(const std::string& key, double fallback) {
-    return has(key) ? number(key) : fallback;
-  }
-  double positive(const std::string& key) {
-    const double d = number(key);
-    if (!(d > 0)) fail(fmt::format("\"{}\" must be > 0", key));
-    return d;
-  }
-  double non_negative_or(const std::string& key, double fallback) {
-    const double d = number_or(key, fallback);
-    if (d < 0) fail(fmt::format("\"{}\" must not be negative", key));
-    return d;
-  }
-
-  std::int64_t integer(const std::string& key, std::int64_t lo, std::int64_t hi) {
-    const json& v = get(key);
-    if (!v.is_number_integer() || v.get<std::int64_t>() < lo || v.get<std::int64_t>() > hi) {
-      fail(fmt::format("\"{}\" must be an integer from {} to {}", key, lo, hi));
-    }
-    return v.get<std::int64_t>();
-  }
-  std::int64_t integer_or(const std::string& key, std::int64_t lo, std::int64_t hi,
-                          std::int64_t fallback) {
-    return has(key) ? integer(key, lo, hi) : fallback;
-  }
-
-  bool boolean(const std::string& key) {
-    const json& v = get(key);
-    if (!v.is_boolean()) fail(fmt::format("\"{}\" must be true or false", key));
-    return v.get<bool>();
-  }
-
-  std::string string(const std::string& key) {
-    const json& v = get(key);
-    if (!v.is_string()) fail(fmt::format("\"{}\" must be a string", key));
-    return v.get<std::string>();
-  }
-
-  void no_unknown_keys() const {
-    for (const auto& item : object_.items()) {
-      if (!used_.contains(item.key())) fail(fmt::format("unknown key \"{}\"", item.key()));
-    }
-  }
-
-  [[nodiscard]] const std::string& where() const { return where_; }
-
- private:
-  const json& object_;
-  std::string where_;
-  std::set<std::string> used_;
+  Reader(const nlohmann::json& object, std::string where)
+      : JsonObjectReader(object, std::move(where), std::numeric_limits<double>::infinity()) {}
 };
 
 /// The 16 bytes of command 0EH, in order, named with the unit the emulated law reads them in.

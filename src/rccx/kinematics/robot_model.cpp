@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "rccx/io/file.hpp"
+#include "rccx/io/json_reader.hpp"
 #include "rccx/io/parse.hpp"
 #include "rccx/kinematics/embedded_robots.hpp"
 #include "rccx/math/units.hpp"
@@ -70,83 +71,7 @@ std::string_view to_string(SolverKind kind) noexcept {
 
 namespace {
 
-// Reads a JSON object key by key so that every error names where it is, and so that an unknown
-// key (a typo such as "upper_mm") is refused instead of silently ignored.
-class Reader {
- public:
-  Reader(const json& object, std::string where) : object_(object), where_(std::move(where)) {
-    if (!object_.is_object()) fail("expected an object");
-  }
-
-  [[noreturn]] void fail(const std::string& what) const {
-    throw RobotFileError(fmt::format("{}: {}", where_, what));
-  }
-
-  bool has(const char* key) {
-    used_.insert(key);
-    return object_.contains(key);
-  }
-
-  const json& get(const char* key) {
-    if (!has(key)) fail(fmt::format("missing \"{}\"", key));
-    return object_.at(key);
-  }
-
-  std::string string(const char* key) {
-    const json& v = get(key);
-    if (!v.is_string()) fail(fmt::format("\"{}\" must be a string", key));
-    return v.get<std::string>();
-  }
-
-  /// A finite number no larger than `limit` in magnitude (every key has a unit: beyond a
-  /// million of it a value is a typo, and would overflow the arithmetic of the solvers).
-  double number(const char* key, double limit = 1e6) {
-    const json& v = get(key);
-    if (!v.is_number()) fail(fmt::format("\"{}\" must be a number", key));
-    const double d = v.get<double>();
-    if (!std::isfinite(d)) fail(fmt::format("\"{}\" must be finite", key));
-    if (std::abs(d) > limit)
-      fail(fmt::format("\"{}\" is {:g}; at most {:g} in magnitude", key, d, limit));
-    return d;
-  }
-
-  std::string name(const char* key) {
-    const std::string n = string(key);
-    try {
-      io::check_name(n, fmt::format("\"{}\"", key), 32);
-    } catch (const io::ParseError& e) {
-      fail(e.what());
-    }
-    return n;
-  }
-
-  std::string text(const char* key) {
-    const std::string t = string(key);
-    try {
-      io::check_text(t, fmt::format("\"{}\"", key), 4096);
-    } catch (const io::ParseError& e) {
-      fail(e.what());
-    }
-    return t;
-  }
-
-  double number_or(const char* key, double fallback, double limit = 1e6) {
-    return has(key) ? number(key, limit) : fallback;
-  }
-
-  void no_unknown_keys() const {
-    for (const auto& item : object_.items()) {
-      if (!used_.contains(item.key())) fail(fmt::format("unknown key \"{}\"", item.key()));
-    }
-  }
-
-  const std::string& where() const { return where_; }
-
- private:
-  const json& object_;
-  std::string where_;
-  std::set<std::string> used_;
-};
+using Reader = io::JsonObjectReader<RobotFileError>;
 
 // The optional "dynamics" object of a joint; its keys carry the unit of the joint's type.
 JointDynamics parse_dynamics(const json& j, JointType type, const std::string& where) {
