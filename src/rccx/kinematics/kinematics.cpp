@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "rccx/kinematics/dh_kinematics.hpp"
+#include "rccx/kinematics/dh_step.hpp"
 #include "rccx/kinematics/microbo_kinematics.hpp"
 #include "rccx/kinematics/puma_kinematics.hpp"
 #include "rccx/math/batch_trig.hpp"
@@ -256,14 +257,7 @@ math::Transform Kinematics::chain_forward(const JointVector& q,
   for (std::size_t i = 0; i < dof(); ++i) {
     const Link& l = links_[i];
     const double d = l.d + (l.prismatic ? q[i] : 0.0);
-    // T A_i with A_i of thesis eq. 3.3 multiplied out: its n is (ct, st, 0), its o and a mix
-    // v = T.o ct - T.n st with T.a through alpha.
-    const math::Vec3 n = T.R.n * ct[i] + T.R.o * st[i];
-    const math::Vec3 v = T.R.o * ct[i] - T.R.n * st[i];
-    const math::Vec3 o = v * l.ca + T.R.a * l.sa;
-    const math::Vec3 a = T.R.a * l.ca - v * l.sa;
-    T.p += T.R.a * d + n * l.a;
-    T.R = {n, o, a};
+    apply_dh_link(T, ct[i], st[i], l.ca, l.sa, l.a, d);
     if (frames != nullptr) frames[i] = T;
   }
   return T;

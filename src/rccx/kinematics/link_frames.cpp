@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "rccx/kinematics/dh_step.hpp"
 #include "rccx/math/batch_trig.hpp"
 
 namespace rccx::kin {
@@ -35,13 +36,7 @@ void link_frames(const DhChain& chain, const JointVector& q, std::span<math::Tra
   for (std::size_t i = 0; i < n; ++i) {
     const DhChain::Link& l = chain.links[i];
     const double d = l.d_m + (l.prismatic ? q[i] : 0.0);
-    // T A_i multiplied out as in Kinematics::chain_forward.
-    const math::Vec3 nv = T.R.n * ct[i] + T.R.o * st[i];
-    const math::Vec3 v = T.R.o * ct[i] - T.R.n * st[i];
-    const math::Vec3 o = v * l.cos_alpha + T.R.a * l.sin_alpha;
-    const math::Vec3 a = T.R.a * l.cos_alpha - v * l.sin_alpha;
-    T.p += T.R.a * d + nv * l.a_m;
-    T.R = {nv, o, a};
+    apply_dh_link(T, ct[i], st[i], l.cos_alpha, l.sin_alpha, l.a_m, d);
     out[i] = T;
   }
 }
