@@ -735,8 +735,8 @@ int rccl_cell_open(const char* cell_file) {
     if (path.empty()) {
       // The source tree's (a build), else the installed copy.
       std::error_code ec;
-      path = std::filesystem::exists(RCCX_DEFAULT_CELL, ec) ? RCCX_DEFAULT_CELL
-                                                              : RCCX_INSTALLED_CELL;
+      path =
+          std::filesystem::exists(RCCX_DEFAULT_CELL, ec) ? RCCX_DEFAULT_CELL : RCCX_INSTALLED_CELL;
     }
     try {
       s.cell = rccx::cell::Cell::load(path);
