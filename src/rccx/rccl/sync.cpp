@@ -165,8 +165,7 @@ void Rendezvous::ready(std::size_t slot, double now_s, double duration_s,
                                    std::memory_order_acq_rel);
 }
 
-void Rendezvous::withdraw(std::size_t slot, std::string_view why) noexcept {
-  (void)slot;
+void Rendezvous::withdraw(std::string_view why) noexcept {
   if (start_s() >= 0.0 || broken_.exchange(true, std::memory_order_acq_rel)) return;
   const std::size_t n = std::min(why.size(), why_.size() - 1);
   std::copy_n(why.data(), n, why_.data());

@@ -129,9 +129,9 @@ class Rendezvous {
   /// motion lasts `duration_s` from its start to rest, and it is sampled every `period_s`.
   /// When it is the last one, the start is set. Idempotent until the start is set.
   void ready(std::size_t slot, double now_s, double duration_s, double period_s) noexcept;
-  /// Participant `slot` cannot take part (its motion failed, was halted or cancelled): the
-  /// others' motions are cancelled with `why` (truncated) when they look.
-  void withdraw(std::size_t slot, std::string_view why) noexcept;
+  /// A participant cannot take part (its motion failed, was halted or cancelled; `why` says
+  /// whose, truncated): the others' motions are cancelled with it when they look.
+  void withdraw(std::string_view why) noexcept;
   /// The start (tick time, s) once every participant is ready, else a negative number.
   [[nodiscard]] double start_s() const noexcept { return start_s_.load(std::memory_order_acquire); }
   /// The common duration from start to rest (s, end_together), once started.

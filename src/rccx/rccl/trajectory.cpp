@@ -832,10 +832,8 @@ void TrajectoryGenerator::start_waiting(const SampleContext& ctx, double t) {
 
 void TrajectoryGenerator::withdraw_from(const MotionRequest& r, const Text& why) noexcept {
   if (r.together == nullptr) return;
-  r.together->withdraw(
-      r.slot,
-      std::string_view(
-          text("{}'s motion {} ended before it: {}", ledger_.robot(), r.id, why.data()).data()));
+  r.together->withdraw(std::string_view(
+      text("{}'s motion {} ended before it: {}", ledger_.robot(), r.id, why.data()).data()));
 }
 
 void TrajectoryGenerator::reset(const JointVector& q, double t_s) noexcept {
