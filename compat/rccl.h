@@ -1,28 +1,40 @@
 /*
- * rccl.h: RCCL's 1986 C interface (thesis section 2.4) over rccx, so that the programs of the
- * thesis compile as C and run: on a simulated robot, the Microbo Ecureuil unless the
- * environment says otherwise. Library rccx_compat; error codes and print_rtc_error() are in
- * rtc.h.
+ * rccl.h: RCCL's C interface, as its user's manual (Hayward and Paul, Purdue TR-EE 83-43) and
+ * the thesis (section 2.4) print it, over rccx: transforms with public n, o, a, p vectors,
+ * constant, varb, hold and functionally defined transforms, position equations, queued
+ * motions, teach, on a simulated robot (the Microbo Ecureuil unless the environment says
+ * otherwise). Library rccx_compat (pkg-config rccx-compat); error codes, print_rtc_error() and
+ * the real-time names (control, release, how, chg, terminate) are in rtc.h. docs/RCCL.md lists
+ * every name of the manual and what it maps to in rccx's C++ API.
  *
  * Units are the 1986 ones: mm for lengths, degrees for angles, mm/s and deg/s for speeds,
  * milliseconds for times. (rccx inside works in m, rad and s; this layer converts.)
  *
- *   b  = gen_tr_rot("B", 325.0, 150.0, 300.0, xunit, 180.);    constant transform
- *   p1 = makeposition("P1", t6, EQ, b, TL, t6);                 position equation T6 = B
+ *   b  = gentr_rot("B", 325.0, 150.0, 300.0, xunit, 180.);      constant transform
+ *   h  = newtrans("H", hold);  Trsl(h, 0., 0., 10.);           a hold transform
+ *   p1 = makeposition("P1", t6, EQ, b, h, TL, t6);              position equation T6 = B H
  *   rccl_open(0, 0); rccl_control();                            session, trajectory generator
  *   setvel(100, 100); move(park); waitfor(park->end);           queue a motion, wait its end
- *   setmod('c'); move(p1); move(p2); waitfor(completed);        Cartesian segments, joined
+ *   h->p.z += 10.; move(p1);                                    h is read when move() is called
+ *   setmod('c'); move(p1); stop(500); waitfor(completed);       Cartesian segment, a dwell
  *   rccl_close(0);
  *
  * Time. rccx simulates the arm in simulated time, which runs only while the program waits:
  * `waitfor(cond)` runs the session one sample at a time until `cond` is true. move() queues a
  * motion and returns at once, as in 1986; nothing moves until the program waits.
  *
+ * C dialects. The headers compile without warnings under -std=gnu89, -std=c99 and -std=c11
+ * (-Wall -Wextra -pedantic). Old programs that call functions without declaring them compile
+ * under gnu89; add -Werror=implicit-function-declaration to have the compiler refuse a call of
+ * a name this header does not declare (a misspelt RCCL call) instead of guessing its type.
+ * newtrans() is a macro that needs variadic macros (C99, or GNU C89).
+ *
  * Environment: RCCX_ROBOT = a shipped robot's name ("microbo", "puma560", ...; `rccx kin
  * robots` lists them) or a robot file (a path ending in .json); default "microbo".
  * RCCX_LOG = FILE writes a CSV row per controlled sample: t, segment (the motion's number,
- * 1, 2, ... in the order of the move() calls since rccl_open; 0 at rest), commanded and
- * measured joints, the commanded tool pose.
+ * 1, 2, ... in the order of the move() and stop() calls since rccl_open; 0 at rest), commanded
+ * and measured joints, the commanded tool pose. RCCX_DB = the position database teach() reads
+ * and writes (default rccx.db in the working directory).
  *
  * Errors. No call aborts the program. A call that fails returns nonzero (or NULL), sets
  * rtc_error and keeps a message (rtc.h); the calls a 1986 program did not check (all but
@@ -31,58 +43,247 @@
  * went wrong in the session (control ended, a motion failed, a move() was refused), so that a
  * program which checks only rccl_close(), as the thesis's do, still exits with an error.
  *
- * One thread: call everything from the program's main thread.
+ * Threads: call everything from the program's main thread. Functions of functionally defined
+ * transforms run in the sample loop (see newtrans).
  */
 #ifndef RCCX_COMPAT_RCCL_H
 #define RCCX_COMPAT_RCCL_H
+
+#include <stdio.h> /* FILE, for printr and printv */
 
 #ifdef __cplusplus
 extern "C" {
 #endif
 
-/* --- Transforms ------------------------------------------------------------------------- */
+#ifndef YES
+#define YES 1
+#endif
+#ifndef NO
+#define NO 0
+#endif
 
-/** A transform of a position equation (opaque; made by gen_tr_rot, or t6). */
-typedef struct rccl_trsf* TRSF_PTR;
+/* --- Vectors ----------------------------------------------------------------------------- */
 
-/** A vector: a rotation axis (any length but zero; only its direction counts). */
+/** A vector: a position (mm) or a direction (unitless). */
 typedef struct vect {
   double x, y, z;
-} VECT;
+} VECT, *VECT_PTR;
 
-/** The unit vectors along the base frame's axes, for gen_tr_rot's axis. */
+/** The unit vectors along the axes, for rotation axes: gentr_rot(..., xunit, 90.). */
 extern const VECT xunit, yunit, zunit;
+
+/* --- Transforms -------------------------------------------------------------------------- */
+
+/** Any C function; newtrans() casts a transform's function to it (K&R functions included). */
+typedef void (*RCCL_FN)(void);
+
+/** What a transform is (TRSF.type). */
+#define RCCL_CONST 1  /* constant: its value is read when a motion is queued (move) */
+#define RCCL_VARB 2   /* variable: read again at every sample while a motion uses it */
+#define RCCL_HOLD 3   /* hold: its value is read when move() is called and kept by that motion */
+#define RCCL_FUNCT 4  /* functionally defined: fn(t) sets its value at every sample */
+#define RCCL_T6 5     /* T6 itself */
+#define RCCL_SYSTEM 6 /* computed by rccx (another robot's tool frame, mnp_tool_frame) */
+
+/**
+ * A homogeneous transform: the rotation's columns n, o, a (unit vectors, n = o x a) and the
+ * position p (mm). A program reads and writes the vectors directly (b->p.z += 10.;). Those
+ * made by newtrans() and gentr_*() have a name and a type and may stand in position
+ * equations; any other TRSF (a local variable) serves the algebra below.
+ */
+typedef struct trsf {
+  VECT n, o, a, p;
+  const char* name; /* as given to newtrans / gentr_* ("" for others) */
+  int type;         /* RCCL_CONST, RCCL_VARB, RCCL_HOLD, RCCL_FUNCT, RCCL_T6, RCCL_SYSTEM */
+  RCCL_FN fn;       /* RCCL_FUNCT: the function; else NULL */
+  long age;         /* the sample in which fn last ran (-1: never) */
+  void* rccx;       /* rccx's own: do not touch */
+} TRSF, *TRSF_PTR;
 
 /**
  * T6: the pose of the robot's last link in its base frame, the unknown of every position
- * equation (RCCL's t6).
+ * equation. Its n, o, a, p hold the measured T6 after each sample a wait lets run.
  */
 extern TRSF_PTR const t6;
 
-/**
- * A constant transform named `name`: a translation of (x_mm, y_mm, z_mm) (mm) and a rotation
- * of `angle_deg` (degrees, right-handed) about `axis`, Trans(x, y, z) Rot(axis, angle).
- * NULL on error (a zero or non-finite axis, a non-finite number): rtc_error is
- * RTC_E_ARGUMENT. The transform lives until the program ends.
+/*
+ * newtrans(name, type): a new transform, the identity, named `name`. `type` is written as in
+ * the manual: const, varb, hold, or the name of a function (a functionally defined transform):
+ *
+ *     trans = rot(newtrans("TRANS", const), zunit, 90.);
+ *     conv  = newtrans("CONV", convfn);
+ *
+ *     int convfn(t) TRSF_PTR t; { t->p.y = 100. + 0.5 * rtime; return 0; }
+ *
+ * `const` is a C keyword; newtrans is a macro so that it can still be written there (CONST and
+ * RCCL_CONST work too). `type` must be one of those names, not an expression: for a function
+ * pointer held in a variable, call rccl_newtrans(name, RCCL_FUNCT, (RCCL_FN)fp).
+ *
+ * A function is called once per sample (in the sample loop, while a motion that uses the
+ * transform is queued or runs) as fn(t), t the transform; it sets t's n, o, a, p (mm), and may
+ * read rtime and rccl_sample, and set nextmove (a monitor). It must return quickly and must not
+ * call this library (except the algebra below). Its value is not called between samples:
+ * move() and update() use the value it last set.
+ *
+ * NULL on error (a NULL function): rtc_error RTC_E_ARGUMENT. The transform lives until the
+ * program ends.
  */
-TRSF_PTR gen_tr_rot(const char* name, double x_mm, double y_mm, double z_mm, VECT axis,
-                    double angle_deg);
+TRSF_PTR rccl_newtrans(const char* name, int type, RCCL_FN fn);
+/* Variadic macros are C99 (and GNU C89): say so to a -pedantic gnu89 build only once, here. */
+#if defined(__GNUC__)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wvariadic-macros"
+#endif
+#define RCCL_NT_2ND(a, b, ...) b
+#define RCCL_NT_2ND_(...) RCCL_NT_2ND(__VA_ARGS__)
+#if defined(__GNUC__)
+#pragma GCC diagnostic pop
+#endif
+#define RCCL_NT_TYPE_const ~, RCCL_CONST
+#define RCCL_NT_TYPE_CONST ~, RCCL_CONST
+#define RCCL_NT_TYPE_RCCL_CONST ~, RCCL_CONST
+#define RCCL_NT_TYPE_varb ~, RCCL_VARB
+#define RCCL_NT_TYPE_VARB ~, RCCL_VARB
+#define RCCL_NT_TYPE_RCCL_VARB ~, RCCL_VARB
+#define RCCL_NT_TYPE_hold ~, RCCL_HOLD
+#define RCCL_NT_TYPE_HOLD ~, RCCL_HOLD
+#define RCCL_NT_TYPE_RCCL_HOLD ~, RCCL_HOLD
+#define RCCL_NT_FN_const ~, (RCCL_FN)0
+#define RCCL_NT_FN_CONST ~, (RCCL_FN)0
+#define RCCL_NT_FN_RCCL_CONST ~, (RCCL_FN)0
+#define RCCL_NT_FN_varb ~, (RCCL_FN)0
+#define RCCL_NT_FN_VARB ~, (RCCL_FN)0
+#define RCCL_NT_FN_RCCL_VARB ~, (RCCL_FN)0
+#define RCCL_NT_FN_hold ~, (RCCL_FN)0
+#define RCCL_NT_FN_HOLD ~, (RCCL_FN)0
+#define RCCL_NT_FN_RCCL_HOLD ~, (RCCL_FN)0
+#define newtrans(name, type)                                          \
+  rccl_newtrans((name), RCCL_NT_2ND_(RCCL_NT_TYPE_##type, RCCL_FUNCT, ~), \
+                RCCL_NT_2ND_(RCCL_NT_FN_##type, (RCCL_FN)(type), ~))
+
+/**
+ * Functions of functionally defined transforms may read these: the time of the sample being
+ * computed, in ms since rccl_control() (rtime), and its number (rccl_sample, 1, 2, ...).
+ * Between samples they hold the last sample's.
+ */
+extern long rtime;
+extern long rccl_sample;
+
+/*
+ * Constant transforms made and set in one call (the manual's gentr_ family; the thesis spells
+ * them gen_tr_, both work). Translation (x, y, z) in mm, then the rotation:
+ *   gentr_trsl  Trans(x, y, z)
+ *   gentr_rot   Trans(x, y, z) Rot(axis, angle_deg)          (axis: any nonzero vector)
+ *   gentr_eul   Trans(x, y, z) Rot(z, phi) Rot(y, theta) Rot(z, psi)          (Euler, deg)
+ *   gentr_rpy   Trans(x, y, z) Rot(z, roll) Rot(y, pitch) Rot(x, yaw)  (roll, pitch, yaw, deg)
+ *   gentr_pao   position p, approach vector a, orientation vector o (n = o x a; a and o are
+ *               made unit and o orthogonal to a)
+ * NULL on error (a zero axis, parallel a and o, a number that is not finite): RTC_E_ARGUMENT.
+ */
+TRSF_PTR gentr_trsl(const char* name, double x_mm, double y_mm, double z_mm);
+TRSF_PTR gentr_rot(const char* name, double x_mm, double y_mm, double z_mm, VECT axis,
+                   double angle_deg);
+TRSF_PTR gentr_eul(const char* name, double x_mm, double y_mm, double z_mm, double phi_deg,
+                   double theta_deg, double psi_deg);
+TRSF_PTR gentr_rpy(const char* name, double x_mm, double y_mm, double z_mm, double roll_deg,
+                   double pitch_deg, double yaw_deg);
+TRSF_PTR gentr_pao(const char* name, double px_mm, double py_mm, double pz_mm, double ax,
+                   double ay, double az, double ox, double oy, double oz);
+#define gen_tr_trsl gentr_trsl
+#define gen_tr_rot gentr_rot
+#define gen_tr_eul gentr_eul
+#define gen_tr_rpy gentr_rpy
+#define gen_tr_pao gentr_pao
+
+/*
+ * The algebra of the manual's "basic components" (any TRSF, named or not). Each function puts
+ * its result in its first argument and returns it (as strcat does); each has a capitalised
+ * form that is a statement, `#define Rot (void) rot`. Results may alias arguments. Positions in
+ * mm, angles in degrees. Rotations are exact (no renormalisation); see unit().
+ */
+TRSF_PTR trmult(TRSF_PTR r, const TRSF* t1, const TRSF* t2);    /* r = t1 t2 */
+TRSF_PTR trmultinv(TRSF_PTR r, const TRSF* t1, const TRSF* t2); /* r = t1 t2^-1 */
+TRSF_PTR invtrmult(TRSF_PTR r, const TRSF* t1, const TRSF* t2); /* r = t1^-1 t2 */
+TRSF_PTR invert(TRSF_PTR r, const TRSF* t);                     /* r = t^-1 */
+TRSF_PTR assigntr(TRSF_PTR r, const TRSF* t);                   /* r = t (the value only) */
+TRSF_PTR ident(TRSF_PTR r);                                     /* r = I */
+TRSF_PTR rot(TRSF_PTR r, VECT axis, double angle_deg);          /* r = Rot(axis, angle) */
+TRSF_PTR trsl(TRSF_PTR r, double x_mm, double y_mm, double z_mm); /* r = Trans(x, y, z) */
+TRSF_PTR eul(TRSF_PTR r, double phi_deg, double theta_deg, double psi_deg); /* r = Euler zyz */
+TRSF_PTR rpy(TRSF_PTR r, double roll_deg, double pitch_deg, double yaw_deg); /* r = RPY */
+TRSF_PTR rotr(TRSF_PTR r, VECT axis, double angle_deg); /* r = r Rot(axis, angle): turn in r's frame */
+TRSF_PTR trslr(TRSF_PTR r, double x_mm, double y_mm, double z_mm); /* r = r Trans: move in r's frame */
+TRSF_PTR takerot(TRSF_PTR r, const TRSF* t);  /* r's rotation = t's (r.p kept) */
+TRSF_PTR taketrsl(TRSF_PTR r, const TRSF* t); /* r.p = t.p (r's rotation kept) */
+/* The Euler (zyz) and roll-pitch-yaw angles of t (deg), through pointers; returns t. */
+const TRSF* trtoeul(const TRSF* t, double* phi_deg, double* theta_deg, double* psi_deg);
+const TRSF* trtorpy(const TRSF* t, double* roll_deg, double* pitch_deg, double* yaw_deg);
+#define Trmult (void) trmult
+#define Trmultinv (void) trmultinv
+#define Invtrmult (void) invtrmult
+#define Invert (void) invert
+#define Assigntr (void) assigntr
+#define Ident (void) ident
+#define Rot (void) rot
+#define Trsl (void) trsl
+#define Eul (void) eul
+#define Rpy (void) rpy
+#define Rotr (void) rotr
+#define Trslr (void) trslr
+#define Takerot (void) takerot
+#define Taketrsl (void) taketrsl
+#define Trtoeul (void) trtoeul
+#define Trtorpy (void) trtorpy
+
+VECT_PTR vecmult(VECT_PTR r, const TRSF* t, const VECT* v);   /* r = t v (a point: R v + p) */
+VECT_PTR rotvec(VECT_PTR r, const TRSF* t, const VECT* v);    /* r = R v (a direction) */
+VECT_PTR vecadd(VECT_PTR r, const VECT* u, const VECT* v);    /* r = u + v */
+VECT_PTR vecsub(VECT_PTR r, const VECT* u, const VECT* v);    /* r = u - v */
+VECT_PTR vecscale(VECT_PTR r, const VECT* v, double s);       /* r = s v */
+VECT_PTR cross(VECT_PTR r, const VECT* u, const VECT* v);     /* r = u x v */
+VECT_PTR unit(VECT_PTR r, const VECT* v);                     /* r = v / |v| (zero stays zero) */
+double dot(const VECT* u, const VECT* v);                     /* u . v */
+double norm(const VECT* v);                                   /* |v| */
+#define Vecmult (void) vecmult
+#define Rotvec (void) rotvec
+#define Vecadd (void) vecadd
+#define Vecsub (void) vecsub
+#define Vecscale (void) vecscale
+#define Cross (void) cross
+#define Unit (void) unit
+
+/*
+ * Printing, on `fp` (stdout, stderr, a file): printr the name and the 3 x 4 matrix (rows of
+ * n o a p, p in mm), printv a vector. printtr is another name for printr. They return their
+ * first argument.
+ */
+const TRSF* printr(const TRSF* t, FILE* fp);
+const VECT* printv(const VECT* v, FILE* fp);
+#define printtr printr
+#define Printr (void) printr
+#define Printv (void) printv
 
 /* --- Positions ---------------------------------------------------------------------------- */
 
-/** A position equation made by makeposition (or park). */
+/** A position equation made by makeposition (or park). Read-only for the program. */
 typedef struct rccl_position {
   /**
    * True (1) when no motion to this position is queued or running: every motion move()
    * queued to it has ended (or failed, or was cancelled). move() sets it to 0 at once; it
    * becomes 1 again in the sample the last such motion ends, so `waitfor(p->end)` waits for
-   * the arm to get there. Updated by every call of this library and every waited sample;
-   * read-only for the program.
+   * the arm to get there. Updated by every call of this library and every waited sample.
    */
   int end;
   /** The name given to makeposition ("park" for park). */
   const char* name;
+  /**
+   * How the last motion to it that ended ended: 0 normally (at the goal), RCCL_NEXTMOVE when
+   * nextmove ended it before the goal, RTC_E_MOTION when it failed or was cancelled.
+   */
+  int code;
 } POS, *POS_PTR;
+
+#define RCCL_NEXTMOVE 1 /* POS.code: ended early by nextmove */
 
 /** The separators of makeposition's list: left side, EQ, right side, TL, tool. */
 extern TRSF_PTR const rccl_EQ;
@@ -95,13 +296,15 @@ extern TRSF_PTR const rccl_TL;
  * of the right side, TL, and the tool transform (one of the left side's at or after t6; t6
  * itself for no tool):
  *
- *     makeposition("P1", t6, EQ, b, TL, t6)          T6 = B
- *     makeposition("P", z, t6, tool, EQ, conv, obj, TL, tool)   Z T6 TOOL = CONV OBJ
+ *     makeposition("P1", t6, EQ, b, TL, t6)                      T6 = B
+ *     makeposition("P", z, t6, tool, EQ, conv, obj, TL, tool)    Z T6 TOOL = CONV OBJ
  *
- * Every argument after the name is a TRSF_PTR. The list ends after the transform that
- * follows TL; it must contain EQ then TL (a NULL, an unknown pointer or TL before EQ stops
- * it). NULL on error, with rtc_error = RTC_E_EQUATION (or RTC_E_ARGUMENT) and a message
- * saying what is wrong. The position lives until the program ends.
+ * Every argument after the name is a TRSF_PTR made by newtrans or gentr_* (or t6). The list
+ * ends after the transform that follows TL; it must contain EQ then TL (a NULL, an unknown
+ * pointer or TL before EQ stops it). NULL on error, with rtc_error = RTC_E_EQUATION (or
+ * RTC_E_ARGUMENT) and a message saying what is wrong. The position lives until the program
+ * ends. Transforms are read when a motion to it is queued (const, hold) or at each sample
+ * (varb, functional), not here.
  */
 POS_PTR makeposition(const char* name, ...);
 
@@ -154,32 +357,72 @@ int setvel(double mm_per_s, double deg_per_s);
 int setmod(int mode);
 
 /**
- * settime: the transition time `transition_ms` (ms, > 0: the length of the quartic blend
- * into the next segment, centred on the via point; default 200 ms) and the segment time
- * `segment_ms` (ms; > 0: each segment lasts that long, 0: from the speeds of setvel, the
- * default). The thesis (2.4.2) names both times but not their order: the transition time
- * comes first here. Times are lengthened when a joint would exceed its speed or acceleration
- * bound. Returns 0 or RTC_E_ARGUMENT.
+ * settime: the transition time `transition_ms` (ms, > 0: the length of the blend into the
+ * next segment, centred on the via point; default 200 ms) and the segment time `segment_ms`
+ * (ms; > 0: each segment lasts that long, 0: from the speeds of setvel, the default). The
+ * thesis (2.4.2) names both times but not their order: the transition time comes first here.
+ * Times are lengthened when a joint would exceed its speed or acceleration bound (the
+ * generator slows down rather than fail). Returns 0 or RTC_E_ARGUMENT.
  */
 int settime(double transition_ms, double segment_ms);
+
+/**
+ * setconf: the arm configuration the next joint-mode motions reach their goals in, as letters
+ * or words: for the PUMA l/r (lefty, righty: the shoulder), u/d (up, down: the elbow), n/f
+ * (noflip, flip: the wrist), e.g. "lun", "r", "righty down flip"; for the Microbo n/f. Letters
+ * not given keep the arm's present ones; "" goes back to "stay in the present configuration"
+ * (the default). A Cartesian motion cannot change configuration: move() refuses, at the call,
+ * a Cartesian goal the present configuration does not reach (RTC_E_UNREACHABLE), saying which
+ * configuration does. Returns 0, or RTC_E_ARGUMENT for a letter the robot does not have.
+ */
+int setconf(const char* configuration);
 
 /* --- Motions ----------------------------------------------------------------------------- */
 
 /**
  * Queues a motion to `p` with the present settings and returns at once; the trajectory
- * generator joins queued motions with transitions. Motions are numbered 1, 2, ... in the
- * order of the calls (the `segment` column of the RCCX_LOG file). Returns 0, or an error
- * code: RTC_E_UNREACHABLE (a fixed goal that no configuration reaches within the joint
- * limits, a full queue), RTC_E_SEQUENCE (before rccl_control), RTC_E_TERMINATED (control
- * has ended), RTC_E_ARGUMENT (a null or unknown position). Nothing is queued on error.
+ * generator joins queued motions with transitions. Const and hold transforms of the equation
+ * are read now (a later change reaches the next move), varb and functional ones at every
+ * sample. Motions are numbered 1, 2, ... in the order of the move() and stop() calls (the
+ * `segment` column of the RCCX_LOG file). Returns 0, or an error code: RTC_E_UNREACHABLE (a
+ * goal that no configuration reaches within the joint limits, a Cartesian goal the present
+ * configuration does not reach, a full queue), RTC_E_EQUATION (a const or hold transform set
+ * to a value that is not a rigid transform), RTC_E_SEQUENCE (before rccl_control),
+ * RTC_E_TERMINATED (control has ended), RTC_E_ARGUMENT (a null or unknown position). Nothing is
+ * queued on error.
  */
 int move(POS_PTR p);
+
+/**
+ * stop: stay where the motion queued before ends, for `ms` milliseconds (> 0), then go on
+ * with the next. Queued like move(). Returns 0 or an error code as move().
+ */
+int stop(double ms);
+
+/**
+ * distance: displaces the goal of the next move() in the tool frame of its equation: `what`
+ * lists the displacements, each followed by its value among the arguments (double):
+ * "dx", "dy", "dz" in mm, "rx", "ry", "rz" in deg (a rotation about that tool axis, applied
+ * after the translations), e.g. distance("dz", -30.) then move(p): 30 mm short of p along the
+ * tool's z; distance("dx dz", 10., 5.). Several calls add up; the next move() takes them.
+ * Returns 0 or RTC_E_ARGUMENT (an unknown word; nothing is changed).
+ */
+int distance(const char* what, ...);
 
 /**
  * True (1) when every motion queued so far has ended (the queue is empty and the arm at
  * rest): `waitfor(completed)`. Updated like POS.end.
  */
 extern int completed;
+
+/**
+ * nextmove: set it to YES (from the program, or from a transform's function in the sample
+ * loop: a monitor) to end the motion running now: the arm stops smoothly where it is (every
+ * joint within its bounds), that motion ends (its POS.code becomes RCCL_NEXTMOVE) and the next
+ * queued motion starts from there. The library sets it back to NO when it has acted on it
+ * (at once when no motion runs).
+ */
+extern volatile int nextmove;
 
 /**
  * Lets one sample of the session run (in simulated time; in real time, waits one period),
@@ -201,6 +444,37 @@ int rccl_wait_sample(void);
     }                                     \
   } while (0)
 
+/* --- Solving for a transform: update and teach ---------------------------------------------- */
+
+/**
+ * update(trans, pos): sets `trans` (one of pos's transforms, not t6) to the value that makes
+ * the equation of `pos` hold with T6 where the arm is now (measured), the other transforms at
+ * their present values. For a hold transform the next move() takes it. Returns trans, or NULL
+ * (RTC_E_ARGUMENT: trans is not in pos, or is t6; RTC_E_SEQUENCE: no session).
+ */
+TRSF_PTR update(TRSF_PTR trans, POS_PTR pos);
+
+/**
+ * teach(trans, pos): as the manual's teach mode. `trans` is first looked up by its name in the
+ * position database (RCCX_DB, default rccx.db), for this robot: when found, trans takes that
+ * value and teach returns YES at once. Otherwise the teach loop runs on the terminal
+ * ("teach mode V1.0, transform TRANS, position POS"; `?` lists the commands: zero gravity, a
+ * joint to a value, jogging, ...); `e` records T6 there, solves trans as update() does,
+ * stores it in the database under its name and returns YES. The loop ending otherwise (the
+ * input runs out, Ctrl-C, control ends) returns NO and leaves trans as it was. Waits for the
+ * queued motions to end first.
+ */
+int teach(TRSF_PTR trans, POS_PTR pos);
+
+/* --- Force: not yet --------------------------------------------------------------------------- */
+
+/**
+ * comply / lock: compliance along tool axes (the manual's force control). Declared so that
+ * programs that use them compile; in this version they change nothing and return
+ * RTC_E_NOT_YET with a message (rccx gains force sensing on a simulated plant later).
+ */
+int comply(const char* what, ...);
+int lock(const char* what);
 
 /* --- Several robots: a workcell (Multi-RCCL style) ------------------------------------------- */
 /*

@@ -1,114 +1,60 @@
-// RCCL's 1986 C interface (compat/rccl.h, compat/rtc.h) over rccx::rccl: the thesis's calls
-// with its units (mm, deg, ms) on a simulated robot (rtc::SimulatedRobot) and one
-// rccl::Manipulator. No exception leaves this file: every entry point catches, sets rtc_error,
-// keeps the message and returns an error code (or NULL).
+// RCCL's C interface (compat/rccl.h, compat/rtc.h) over rccx::rccl: the manual's and the
+// thesis's calls with their units (mm, deg, ms) on a simulated robot (rtc::SimulatedRobot) and
+// one rccl::Manipulator. No exception leaves this file: every entry point catches, sets
+// rtc_error, keeps the message and returns an error code (or NULL).
 //
-// The C side sees plain values that this file keeps up to date: POS.end (no motion to the
-// position pending, from Position::pending_ends) and `completed` (every queued motion ended),
-// refreshed by every call and after every sample waitfor() lets run.
-#include <fmt/format.h>
-
-#include <array>
+// The C side sees plain values that this file keeps up to date: POS.end and POS.code (from
+// the positions each move() built and the generator's events), `completed` (every queued
+// motion ended) and t6's value, refreshed by every call and after every sample waitfor() lets
+// run. Transforms are in rccl_transforms.cpp and rccl_algebra.cpp, the cell in rccl_cell.cpp.
 #include <atomic>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstdarg>
-#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
-#include <filesystem>
-#include <map>
-#include <memory>
-#include <stdexcept>
+#include <iostream>
+#include <numbers>
+#include <optional>
 #include <string>
-#include <string_view>
 #include <utility>
-#include <vector>
 
-#include "rccx/cell/cell.hpp"
-#include "rccx/kinematics/robot_model.hpp"
-#include "rccx/math/transform.hpp"
-#include "rccx/math/units.hpp"
-#include "rccx/rccl/manipulator.hpp"
-#include "rccx/rccl/position.hpp"
-#include "rccx/rccl/transforms.hpp"
-#include "rccx/rtc/sample_log.hpp"
-#include "rccx/rtc/session.hpp"
-#include "rccx/rtc/simulated_robot.hpp"
+#include "compat_internal.hpp"
+#include "rccx/rccl/position_db.hpp"
+#include "rccx/rccl/teach.hpp"
 
-// The C headers last, so that their macros (EQ, TL, waitfor) never reach rccx's headers. Their
-// global names (move, park, t6, completed) are why this file always writes std::move.
-#include "rccl.h"
-#include "rtc.h"
+namespace rccx::compat {
 
-/// What a TRSF_PTR points to: a shared rccx transform (null for the EQ and TL marks).
-struct rccl_trsf {
-  rccx::rccl::TransformPtr transform;
-};
-
-/// What a MANIP points to: a robot of the open cell and its own settings.
-struct rccl_manip {
-  std::string name;
-  rccx::rccl::Manipulator* arm = nullptr;
-  rccx::rccl::MotionSettings settings;  ///< mnp_setvel, mnp_setmod, mnp_settime
-  rccx::rccl::StartWhen next;           ///< mnp_after / rccl_together, for the next mnp_move
-  POS* park = nullptr;
-  TRSF_PTR tool = nullptr, base_inv = nullptr, tool_frame = nullptr;
-  std::size_t failures_seen = 0;
-  bool told_ended = false;
-  std::map<std::uint64_t, std::string> motion_names;
-};
-
-namespace {
-
-namespace math = rccx::math;
-namespace kin = rccx::kin;
-namespace rtc = rccx::rtc;
-namespace rc = rccx::rccl;
-
-/// A position the C program holds: the POS it sees and the equation behind it.
-struct PositionBox {
-  POS c{1, nullptr};
-  std::string name;
-  rc::PositionPtr position;
-};
-
-/// Everything the C calls share. Members are destroyed in reverse order: the manipulator
-/// before the robot whose session it uses, both before the positions and transforms.
-struct State {
-  std::map<const rccl_trsf*, std::unique_ptr<rccl_trsf>> transforms;
-  std::map<const POS*, std::unique_ptr<PositionBox>> positions;
-  rc::MotionSettings settings;  ///< setvel, setmod, settime: applied at each move()
-  std::unique_ptr<rtc::SimulatedRobot> robot;
-  std::unique_ptr<rc::Manipulator> arm;
-  bool controlling = false;  ///< rccl_control() was called in this session
-  bool told_ended = false;   ///< the end of control was printed
-  std::size_t failures_seen = 0;
-  std::size_t refused_moves = 0;  ///< move() calls that failed in this session
-  int first_refusal_code = RTC_OK;
-  std::string first_refusal;
-  std::map<std::uint64_t, std::string> motion_names;  ///< motion id -> position name
-  std::string message;                                ///< the last error's
-  // A cell (rccl_cell_open): declared last, so that it stops before the positions and
-  // transforms its generators point to go.
-  std::map<std::string, std::unique_ptr<rccl_manip>, std::less<>> manips;
-  std::unique_ptr<rccx::cell::Cell> cell;
-  bool cell_started = false;
-};
+/// Set by the sample loop when a transform's function set nextmove with no generator to tell
+/// (taken at the next wait).
+std::atomic<bool> loop_saw_nextmove{false};
 
 State& state() {
   static State s;
   return s;
 }
 
-rccl_trsf t6_box{rc::t6()};
-rccl_trsf eq_mark{};
-rccl_trsf tl_mark{};
-POS park_box{1, "park"};
+TrsfBox& t6_box() {
+  static TrsfBox b = [] {
+    TrsfBox box;
+    box.name = "T6";
+    box.live = rc::t6();
+    to_c(math::Transform::identity(), box.c);
+    box.c.type = RCCL_T6;
+    box.c.age = -1;
+    return box;
+  }();
+  b.c.name = b.name.c_str();
+  b.c.rccx = &b;
+  return b;
+}
 
-enum class Say : bool { quiet, print };
+POS& park_box() {
+  static POS p{1, "park", 0};
+  return p;
+}
 
-/// Records an error: rtc_error, the message, and (Say::print) a line on stderr.
 int fail(int code, std::string_view text, Say say) noexcept {
   rtc_error = code;
   try {
@@ -120,71 +66,256 @@ int fail(int code, std::string_view text, Say say) noexcept {
   return code;
 }
 
-/// Runs `body` (which returns an error code); an exception becomes an error code. `invalid` is
-/// the code for std::invalid_argument, whose meaning depends on the call.
-template <class F>
-int guarded(const char* call, Say say, int invalid, F&& body) noexcept {
-  const auto failed = [&](int code, const char* what) noexcept {
-    try {
-      return fail(code, fmt::format("{}: {}", call, what), say);
-    } catch (...) {
-      return fail(code, what, say);
-    }
-  };
-  try {
-    return body();
-  } catch (const rc::EquationError& e) {
-    return failed(RTC_E_EQUATION, e.what());
-  } catch (const rc::MotionError& e) {
-    return failed(RTC_E_UNREACHABLE, e.what());
-  } catch (const kin::RobotFileError& e) {
-    return failed(RTC_E_ROBOT, e.what());
-  } catch (const rtc::LogError& e) {
-    return failed(RTC_E_OPEN, e.what());
-  } catch (const rtc::SessionError& e) {
-    return failed(RTC_E_OPEN, e.what());
-  } catch (const std::invalid_argument& e) {
-    return failed(invalid, e.what());
-  } catch (const std::exception& e) {
-    return failed(RTC_E_INTERNAL, e.what());
-  } catch (...) {
-    return failed(RTC_E_INTERNAL, "an unknown exception");
-  }
-}
-
-bool finite(std::initializer_list<double> values) noexcept {
-  for (const double v : values) {
-    if (!std::isfinite(v)) return false;
-  }
-  return true;
-}
-
-/// Brings POS.end and `completed` up to date with the trajectory generator.
 void refresh() noexcept {
   State& s = state();
   for (auto& [key, box] : s.positions) {
-    box->c.end = box->position->pending_ends.load(std::memory_order_acquire) <= 0 ? 1 : 0;
+    std::erase_if(box->queued, [](const rc::PositionPtr& p) {
+      return p->pending_ends.load(std::memory_order_acquire) <= 0;
+    });
+    box->shown->end = box->queued.empty() ? 1 : 0;
   }
   if (s.arm) {
-    park_box.end = s.arm->park()->pending_ends.load(std::memory_order_acquire) <= 0 ? 1 : 0;
     completed = s.arm->happened(rc::Manipulator::completed()) ? 1 : 0;
   } else if (s.cell) {
-    park_box.end = 1;
     completed = 1;
     for (const auto& [name, m] : s.manips) {
       if (!m->arm->happened(rc::Manipulator::completed())) completed = 0;
     }
   } else {
-    park_box.end = 1;
     completed = 1;
   }
 }
+
+namespace {
 
 std::string motion_name(const State& s, std::uint64_t id) {
   const auto it = s.motion_names.find(id);
   return it == s.motion_names.end() ? fmt::format("motion {}", id)
                                     : fmt::format("motion {} (to {})", id, it->second);
 }
+
+/// The arm's measured T6 (m, rad).
+math::Transform measured_t6(const State& s) {
+  return s.arm->kinematics().forward(s.robot->session->how().q());
+}
+
+/// Control has ended by itself: RTC_E_TERMINATED, printed the first time only.
+int control_ended(std::string_view call);
+
+/// The configuration `asked` (letters or words) in the robot's names, letters not given taken
+/// from `present`. Throws std::invalid_argument naming the robot's letters.
+std::string configuration_letters(const kin::Kinematics& k, std::string_view asked,
+                                  std::string_view present) {
+  // Each word or letter is one choice: l r (shoulder), u d (elbow), n f (wrist).
+  static constexpr std::array<std::pair<std::string_view, char>, 14> kWords{{
+      {"lefty", 'l'},
+      {"left", 'l'},
+      {"righty", 'r'},
+      {"right", 'r'},
+      {"up", 'u'},
+      {"above", 'u'},
+      {"down", 'd'},
+      {"below", 'd'},
+      {"noflip", 'n'},
+      {"flip", 'f'},
+      {"l", 'l'},
+      {"r", 'r'},
+      {"n", 'n'},
+      {"f", 'f'},
+  }};
+  std::string letters;
+  std::string word;
+  const auto take = [&](std::string_view w) {
+    if (w.empty()) return;
+    for (const auto& [name, letter] : kWords) {
+      if (w == name) {
+        letters += letter;
+        return;
+      }
+    }
+    for (const char c : w) letters += c;  // "lun", "ud": letters run together
+  };
+  for (const char c : asked) {
+    if (c == ' ' || c == ',' || c == '-' || c == '_') {
+      take(word);
+      word.clear();
+    } else {
+      word += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    }
+  }
+  take(word);
+  std::string out(present);
+  const auto names = k.configuration_names();
+  for (const char c : letters) {
+    bool placed = false;
+    for (std::size_t i = 0; i < out.size() && !placed; ++i) {
+      // Position i takes the letters that the robot's names use there.
+      for (const std::string_view n : names) {
+        if (i < n.size() && n[i] == c) {
+          out[i] = c;
+          placed = true;
+          break;
+        }
+      }
+    }
+    if (!placed) {
+      std::string known;
+      for (const std::string_view n : names)
+        known += fmt::format("{}{}", known.empty() ? "" : ", ", n);
+      throw std::invalid_argument(fmt::format(
+          "setconf(\"{}\"): robot {} has no configuration letter '{}'; its configurations are "
+          "{} (l/r shoulder lefty/righty, u/d elbow up/down, n/f wrist noflip/flip)",
+          asked, k.model().name, c, known.empty() ? "none" : known));
+    }
+  }
+  return out;
+}
+
+/// Settings, configuration and the queue's bookkeeping for one move() or stop().
+void apply_settings(State& s) {
+  s.arm->set_mode(s.settings.mode);
+  s.arm->set_velocity(s.settings.translation_m_per_s, s.settings.rotation_rad_per_s);
+  s.arm->set_segment_time(s.settings.segment_time_s);
+  s.arm->set_transition_time(s.settings.transition_time_s);
+  if (s.configuration.empty()) {
+    s.arm->set_configuration("");
+  } else {
+    const kin::Kinematics& k = s.arm->kinematics();
+    const std::string present(
+        k.configuration_names()[k.configuration_of(s.robot->session->how().q()).index]);
+    s.arm->set_configuration(configuration_letters(k, s.configuration, present));
+  }
+}
+
+/// The checks every motion call makes; RTC_OK or the error (printed).
+int check_can_move(State& s, const std::string& what) {
+  if (s.cell) {
+    return fail(RTC_E_SEQUENCE,
+                fmt::format("{}: a cell is open: name the robot, mnp_move(robot, p)", what),
+                Say::print);
+  }
+  if (!s.arm || !s.controlling) {
+    return fail(RTC_E_SEQUENCE,
+                fmt::format("{}: call rccl_open() and rccl_control() before it", what), Say::print);
+  }
+  if (!s.robot->session->controlling()) return control_ended(what);
+  return RTC_OK;
+}
+
+/// A 1986 program does not look at move()'s result: rccl_close() will tell.
+void note_refusal(int code) {
+  State& s = state();
+  if (code != RTC_OK && s.robot && ++s.refused_moves == 1) {
+    s.first_refusal_code = code;
+    try {
+      s.first_refusal = rtc_error_message();
+    } catch (...) {
+    }
+  }
+}
+
+int control_ended(std::string_view call) {
+  State& s = state();
+  const Say say = s.told_ended ? Say::quiet : Say::print;
+  s.told_ended = true;
+  return fail(RTC_E_TERMINATED,
+              fmt::format("{}: {}; rccl_close() the session", call,
+                          describe_end(s.robot->session->termination())),
+              say);
+}
+
+/// The position box of `p` (park included), or null with the error printed.
+PositionBox* position_of(POS_PTR p, const char* call) {
+  State& s = state();
+  if (p == nullptr) {
+    fail(RTC_E_ARGUMENT, fmt::format("{}(NULL): no position (did makeposition fail?)", call),
+         Say::print);
+    return nullptr;
+  }
+  const auto it = s.positions.find(p);
+  if (it == s.positions.end()) {
+    fail(RTC_E_ARGUMENT,
+         fmt::format("{}: {} is not a position made by makeposition() (or park)", call,
+                     static_cast<const void*>(p)),
+         Say::print);
+    return nullptr;
+  }
+  return it->second.get();
+}
+
+/// The box behind `park` for the open session (built on first use).
+PositionBox& park_position(State& s) {
+  auto it = s.positions.find(&park_box());
+  if (it == s.positions.end()) {
+    auto box = std::make_unique<PositionBox>();
+    box->name = "park";
+    box->shown = &park_box();
+    it = s.positions.emplace(&park_box(), std::move(box)).first;
+  }
+  it->second->joints = s.arm->park();
+  return *it->second;
+}
+
+/// The separated arguments of makeposition, read before anything can throw.
+struct EquationArgs {
+  static constexpr std::size_t kMax = 64;
+  std::array<TRSF_PTR, kMax> t{};
+  std::size_t count = 0;
+  std::size_t eq = 0, tl = 0;  ///< indices of EQ and TL in t
+  std::string_view problem;    ///< why reading stopped early
+};
+
+/// Reads up to the transform after TL. Stops at a NULL, an unknown pointer (it is not
+/// dereferenced), EQ twice, TL before EQ or twice: what follows may not be arguments at all.
+void read_equation(std::va_list ap, EquationArgs& a) noexcept {
+  enum { left, right, tool } part = left;
+  for (;;) {
+    if (a.count == EquationArgs::kMax) {
+      a.problem = "more than 64 arguments: is EQ or TL missing?";
+      return;
+    }
+    TRSF_PTR t = va_arg(ap, TRSF_PTR);
+    a.t[a.count++] = t;
+    if (t == nullptr) {
+      a.problem = "a NULL transform (did newtrans or gentr_ fail?)";
+      return;
+    }
+    if (t == rccl_EQ) {
+      if (part != left) {
+        a.problem = part == right ? "EQ twice" : "EQ after TL";
+        return;
+      }
+      a.eq = a.count - 1;
+      part = right;
+      continue;
+    }
+    if (t == rccl_TL) {
+      if (part != right) {
+        a.problem = part == left ? "TL before EQ" : "TL twice";
+        return;
+      }
+      a.tl = a.count - 1;
+      part = tool;
+      continue;
+    }
+    if (box_of(t) == nullptr) {
+      a.problem = "a pointer that is not a transform made by newtrans or gentr_ (or t6)";
+      return;
+    }
+    if (part == tool) return;
+  }
+}
+
+/// The result of a C transform's function, the planning side: `nextmove` set by the program.
+void act_on_nextmove(State& s) noexcept {
+  if (s.arm) s.arm->generator().request_next();
+  for (const auto& [name, m] : s.manips) m->arm->generator().request_next();
+}
+
+TRSF eq_mark{};
+TRSF tl_mark{};
+
+}  // namespace
 
 std::string describe_end(const rtc::Termination& t) {
   std::string out = fmt::format("control ended at t = {:.3f} s with {} ({}", t.time_s,
@@ -196,20 +327,33 @@ std::string describe_end(const rtc::Termination& t) {
   return out;
 }
 
-/// Control has ended by itself: RTC_E_TERMINATED, printed the first time only.
-int control_ended(std::string_view call) {
+void take_nextmove() noexcept {
   State& s = state();
-  const Say say = s.told_ended ? Say::quiet : Say::print;
-  s.told_ended = true;
-  return fail(RTC_E_TERMINATED,
-              fmt::format("{}: {}; rccl_close() the session", call,
-                          describe_end(s.robot->session->termination())),
-              say);
+  if (loop_saw_nextmove.exchange(false) || nextmove != 0) {
+    nextmove = 0;
+    act_on_nextmove(s);
+  }
 }
 
-/// Prints the motions that failed since the last call (and how many were cancelled after).
+void loop_nextmove() noexcept {
+  if (nextmove == 0) return;
+  nextmove = 0;
+  // The loop is the generator's own thread: request_next() takes effect at the next step.
+  act_on_nextmove(state());
+}
+
 void report_failures() {
   State& s = state();
+  // Ended events of nextmove, and failures, set POS.code of the motion's position.
+  for (const rc::MotionEvent& e : s.arm->take_events()) {
+    const auto it = s.motion_boxes.find(e.id);
+    if (it == s.motion_boxes.end()) continue;
+    if (e.kind == rc::EventKind::ended) {
+      it->second->shown->code = e.message() == rc::kNextmoveText ? RCCL_NEXTMOVE : 0;
+    } else if (e.kind == rc::EventKind::failed || e.kind == rc::EventKind::cancelled) {
+      it->second->shown->code = RTC_E_MOTION;
+    }
+  }
   const std::vector<rc::MotionEvent>& f = s.arm->failures();
   std::size_t cancelled = 0;
   for (; s.failures_seen < f.size(); ++s.failures_seen) {
@@ -238,158 +382,19 @@ kin::RobotModel choose_robot(const char* robot) {
   return file ? kin::load_robot_file(name) : kin::builtin_robot(name);
 }
 
-/// The separated arguments of makeposition, read before anything can throw.
-struct EquationArgs {
-  static constexpr std::size_t kMax = 64;
-  std::array<TRSF_PTR, kMax> t{};
-  std::size_t count = 0;
-  std::size_t eq = 0, tl = 0;  ///< indices of EQ and TL in t
-  std::string_view problem;    ///< why reading stopped early
-};
+}  // namespace rccx::compat
 
-/// Reads up to the transform after TL. Stops at a NULL, an unknown pointer (it is not
-/// dereferenced), EQ twice, TL before EQ or twice: what follows may not be arguments at all.
-void read_equation(std::va_list ap, EquationArgs& a) noexcept {
-  const State& s = state();
-  enum { left, right, tool } part = left;
-  for (;;) {
-    if (a.count == EquationArgs::kMax) {
-      a.problem = "more than 64 arguments: is EQ or TL missing?";
-      return;
-    }
-    TRSF_PTR t = va_arg(ap, TRSF_PTR);
-    a.t[a.count++] = t;
-    if (t == nullptr) {
-      a.problem = "a NULL transform (did gen_tr_rot fail?)";
-      return;
-    }
-    if (t == &eq_mark) {
-      if (part != left) {
-        a.problem = part == right ? "EQ twice" : "EQ after TL";
-        return;
-      }
-      a.eq = a.count - 1;
-      part = right;
-      continue;
-    }
-    if (t == &tl_mark) {
-      if (part != right) {
-        a.problem = part == left ? "TL before EQ" : "TL twice";
-        return;
-      }
-      a.tl = a.count - 1;
-      part = tool;
-      continue;
-    }
-    if (t != &t6_box && s.transforms.find(t) == s.transforms.end()) {
-      a.problem = "a pointer that is not a transform (made by gen_tr_rot, or t6)";
-      return;
-    }
-    if (part == tool) return;
-  }
-}
-
-// --- The cell (rccl_cell_open, MANIP) ------------------------------------------------------------
-
-/// Prints the motions of robot m that failed since the last call; true when its control has
-/// ended (printed once).
-bool cell_report(rccl_manip& m) {
-  const std::vector<rc::MotionEvent>& f = m.arm->failures();
-  std::size_t cancelled = 0;
-  for (; m.failures_seen < f.size(); ++m.failures_seen) {
-    const rc::MotionEvent& e = f[m.failures_seen];
-    const auto it = m.motion_names.find(e.id);
-    const std::string what = it == m.motion_names.end()
-                                 ? fmt::format("{} motion {}", m.name, e.id)
-                                 : fmt::format("{} motion {} (to {})", m.name, e.id, it->second);
-    if (e.kind == rc::EventKind::failed || !e.message().empty()) {
-      fail(
-          RTC_E_MOTION,
-          fmt::format("{} {} at t = {:.3f} s: {}", what, rc::to_string(e.kind), e.t_s, e.message()),
-          Say::print);
-    } else {
-      ++cancelled;
-    }
-  }
-  if (cancelled > 0)
-    std::fprintf(stderr, "rccl: %s: %zu queued motion(s) cancelled\n", m.name.c_str(), cancelled);
-  if (m.arm->session().controlling()) return false;
-  if (!m.told_ended) {
-    m.told_ended = true;
-    fail(RTC_E_TERMINATED,
-         fmt::format("{}: {}", m.name, describe_end(m.arm->session().termination())), Say::print);
-  }
-  return true;
-}
-
-/// waitfor() with a cell: one tick of the cell's clock.
-int cell_wait_tick() {
-  State& s = state();
-  if (!s.cell_started) {
-    return fail(RTC_E_SEQUENCE, "waitfor: call rcclStart() before waiting on the cell", Say::print);
-  }
-  bool any = false;
-  for (auto& [name, m] : s.manips) any = any || m->arm->session().controlling();
-  if (any) s.cell->wait_for(s.cell->group().period());
-  bool all_ended = true;
-  for (auto& [name, m] : s.manips) all_ended = cell_report(*m) && all_ended;
-  refresh();
-  if (all_ended) {
-    return fail(RTC_E_TERMINATED, "waitfor: every robot's control has ended; rcclRelease()",
-                Say::quiet);
-  }
-  return RTC_OK;
-}
-
-/// The handle `m` checked: a robot of the open cell.
-rccl_manip* known(const MANIP* m) {
-  const State& s = state();
-  if (m == nullptr || !s.cell) return nullptr;
-  for (const auto& [name, box] : s.manips) {
-    if (box.get() == m) return box.get();
-  }
-  return nullptr;
-}
-
-int bad_handle(const char* call) {
-  return fail(RTC_E_ARGUMENT,
-              fmt::format("{}: not a robot of the open cell (a NULL handle, or one from before "
-                          "rcclRelease); get one from rcclCreate(name, 0)",
-                          call),
-              Say::print);
-}
-
-/// A robot's position or transform, or NULL (with the error) for a bad handle.
-template <class T>
-T* member_of(const MANIP* m, const char* call, T* rccl_manip::*member) {
-  rccl_manip* r = known(m);
-  if (r == nullptr) {
-    bad_handle(call);
-    return nullptr;
-  }
-  return r->*member;
-}
-
-TRSF_PTR keep_transform(rc::TransformPtr t) {
-  auto box = std::make_unique<rccl_trsf>(rccl_trsf{std::move(t)});
-  TRSF_PTR p = box.get();
-  state().transforms.emplace(p, std::move(box));
-  return p;
-}
-
-}  // namespace
+using namespace rccx::compat;
 
 extern "C" {
 
 int rtc_error = RTC_OK;
 int completed = 1;
-const VECT xunit = {1.0, 0.0, 0.0};
-const VECT yunit = {0.0, 1.0, 0.0};
-const VECT zunit = {0.0, 0.0, 1.0};
-TRSF_PTR const t6 = &t6_box;
+volatile int nextmove = 0;
+TRSF_PTR const t6 = &t6_box().c;
 TRSF_PTR const rccl_EQ = &eq_mark;
 TRSF_PTR const rccl_TL = &tl_mark;
-POS_PTR const park = &park_box;
+POS_PTR const park = &park_box();
 
 const char* rtc_error_name(int code) {
   switch (code) {
@@ -413,6 +418,8 @@ const char* rtc_error_name(int code) {
       return "RTC_E_TERMINATED";
     case RTC_E_INTERNAL:
       return "RTC_E_INTERNAL";
+    case RTC_E_NOT_YET:
+      return "RTC_E_NOT_YET";
     default:
       return "unknown";
   }
@@ -423,7 +430,7 @@ const char* rtc_error_message(void) {
 }
 
 void print_rtc_error(int code, int /*flags*/) {
-  static constexpr std::array<const char*, 10> kMeaning = {
+  static constexpr std::array<const char*, 11> kMeaning = {
       "no error",
       "a call out of order (open, control, move, close)",
       "no such robot, or it cannot be simulated",
@@ -434,6 +441,7 @@ void print_rtc_error(int code, int /*flags*/) {
       "a motion failed while it ran",
       "control ended",
       "an unexpected failure inside rccx",
+      "not done by this version of rccx yet",
   };
   const char* meaning = code >= 0 && code < static_cast<int>(kMeaning.size())
                             ? kMeaning[static_cast<std::size_t>(code)]
@@ -442,37 +450,6 @@ void print_rtc_error(int code, int /*flags*/) {
   if (code != RTC_OK && code == rtc_error && message[0] != '\0') meaning = message;
   std::printf("rtc error %d (%s): %s\n", code, rtc_error_name(code), meaning);
   std::fflush(stdout);
-}
-
-TRSF_PTR gen_tr_rot(const char* name, double x_mm, double y_mm, double z_mm, VECT axis,
-                    double angle_deg) {
-  TRSF_PTR out = nullptr;
-  guarded("gen_tr_rot", Say::print, RTC_E_ARGUMENT, [&] {
-    const std::string n = name != nullptr ? name : "?";
-    if (!finite({x_mm, y_mm, z_mm, axis.x, axis.y, axis.z, angle_deg})) {
-      return fail(RTC_E_ARGUMENT,
-                  fmt::format("gen_tr_rot({}): every number must be finite (got {}, {}, {} mm, "
-                              "axis ({}, {}, {}), {} deg)",
-                              n, x_mm, y_mm, z_mm, axis.x, axis.y, axis.z, angle_deg),
-                  Say::print);
-    }
-    const math::Vec3 a{axis.x, axis.y, axis.z};
-    if (!(a.norm() > 0.0)) {
-      return fail(RTC_E_ARGUMENT,
-                  fmt::format("gen_tr_rot({}): the rotation axis is zero; use xunit, yunit, "
-                              "zunit or any nonzero VECT",
-                              n),
-                  Say::print);
-    }
-    const math::Transform value{math::Rot3::about(a, math::deg_to_rad(angle_deg)),
-                                {x_mm * 1e-3, y_mm * 1e-3, z_mm * 1e-3}};
-    auto box = std::make_unique<rccl_trsf>(rccl_trsf{rc::constant(n, value)});
-    TRSF_PTR t = box.get();
-    state().transforms.emplace(t, std::move(box));
-    out = t;
-    return RTC_OK;
-  });
-  return out;
 }
 
 POS_PTR makeposition(const char* name, ...) {
@@ -493,13 +470,32 @@ POS_PTR makeposition(const char* name, ...) {
                               n, a.count, a.problem),
                   Say::print);
     }
-    std::vector<rc::TransformPtr> lhs, rhs;
-    for (std::size_t i = 0; i < a.eq; ++i) lhs.push_back(a.t[i]->transform);
-    for (std::size_t i = a.eq + 1; i < a.tl; ++i) rhs.push_back(a.t[i]->transform);
-    const rc::TransformPtr& tool = a.t[a.tl + 1]->transform;
     auto box = std::make_unique<PositionBox>();
     box->name = n;
-    box->position = rc::Position::make(n, lhs, rhs, tool);
+    for (std::size_t i = 0; i < a.eq; ++i) box->lhs.push_back(a.t[i]);
+    for (std::size_t i = a.eq + 1; i < a.tl; ++i) box->rhs.push_back(a.t[i]);
+    box->tool = a.t[a.tl + 1];
+    // Built once now so that a malformed equation is refused here (the values are checked at
+    // each move(): they may change until then).
+    std::vector<rc::TransformPtr> lhs, rhs;
+    rc::TransformPtr tool;
+    const auto stand_in = [](TRSF* t) {
+      TrsfBox* b = box_of(t);
+      return b == &t6_box() ? rc::t6() : rc::constant(b->name, math::Transform::identity());
+    };
+    for (TRSF* t : box->lhs) {
+      lhs.push_back(stand_in(t));
+      if (t == box->tool) tool = lhs.back();
+    }
+    for (TRSF* t : box->rhs) rhs.push_back(stand_in(t));
+    if (!tool && box->tool != nullptr) {
+      return fail(RTC_E_EQUATION,
+                  fmt::format("makeposition({}): the tool transform after TL ({}) must be one of "
+                              "the left side's, at or after t6 (t6 itself for no tool)",
+                              n, box_of(box->tool)->name),
+                  Say::print);
+    }
+    (void)rc::Position::make(n, lhs, rhs, tool);  // throws EquationError saying what is wrong
     box->c.name = box->name.c_str();
     POS_PTR p = &box->c;
     state().positions.emplace(p, std::move(box));
@@ -538,6 +534,12 @@ int rccl_open(const char* robot, double period_ms) {
     s.refused_moves = 0;
     s.first_refusal.clear();
     s.motion_names.clear();
+    s.motion_boxes.clear();
+    s.displacement = math::Transform::identity();
+    nextmove = 0;
+    loop_saw_nextmove = false;
+    park_position(s);
+    to_c(measured_t6(s), t6_box().c);
     refresh();
     return RTC_OK;
   });
@@ -569,9 +571,13 @@ int rccl_close(int power_off) {
         s.arm.reset();
         s.robot.reset();
         // Motions still queued will never end now.
-        for (auto& [key, box] : s.positions) box->position->pending_ends.store(0);
+        for (auto& [key, box] : s.positions) box->queued.clear();
+        if (auto it = s.positions.find(&park_box()); it != s.positions.end()) {
+          it->second->joints.reset();  // the next session's robot has its own park
+        }
         s.controlling = false;
         s.motion_names.clear();
+        s.motion_boxes.clear();
         refresh();
       }
     } closer{s};
@@ -593,8 +599,10 @@ int rccl_close(int power_off) {
                         first.message().empty() ? "" : ": ", first.message());
     } else if (s.refused_moves > 0) {
       code = s.first_refusal_code;
-      why = fmt::format("{} move() call(s) were refused during the session; the first: {}",
-                        s.refused_moves, s.first_refusal);
+      why = fmt::format(
+          "{} call(s) to queue a motion were refused during the session; the "
+          "first: {}",
+          s.refused_moves, s.first_refusal);
     }
     s.robot->session->close(power_off != 0);
     return code == RTC_OK ? RTC_OK : fail(code, "rccl_close: " + why, Say::quiet);
@@ -611,7 +619,7 @@ int setvel(double mm_per_s, double deg_per_s) {
     }
     State& s = state();
     s.settings.translation_m_per_s = mm_per_s * 1e-3;
-    s.settings.rotation_rad_per_s = math::deg_to_rad(deg_per_s);
+    s.settings.rotation_rad_per_s = deg_per_s * (std::numbers::pi / 180.0);
     return RTC_OK;
   });
 }
@@ -651,56 +659,143 @@ int settime(double transition_ms, double segment_ms) {
   });
 }
 
+int setconf(const char* configuration) {
+  return guarded("setconf", Say::print, RTC_E_ARGUMENT, [&] {
+    State& s = state();
+    const std::string asked = configuration != nullptr ? configuration : "";
+    if (s.arm && !asked.empty()) {
+      // Checked now against the robot's letters (the arm's present ones fill the rest).
+      const kin::Kinematics& k = s.arm->kinematics();
+      if (k.configuration_names().empty()) {
+        return fail(RTC_E_ARGUMENT,
+                    fmt::format("setconf(\"{}\"): robot {} has no named configurations", asked,
+                                k.model().name),
+                    Say::print);
+      }
+      const std::string present(
+          k.configuration_names()[k.configuration_of(s.robot->session->how().q()).index]);
+      (void)configuration_letters(k, asked, present);
+    }
+    s.configuration = asked;
+    return RTC_OK;
+  });
+}
+
 int move(POS_PTR p) {
   const int code = guarded("move", Say::print, RTC_E_ARGUMENT, [&] {
     State& s = state();
-    if (p == nullptr) {
-      return fail(RTC_E_ARGUMENT, "move(NULL): no position (did makeposition fail?)", Say::print);
-    }
-    const auto it = s.positions.find(p);
-    if (p != park && it == s.positions.end()) {
-      return fail(RTC_E_ARGUMENT,
-                  fmt::format("move: {} is not a position made by makeposition() (or park)",
-                              static_cast<const void*>(p)),
-                  Say::print);
-    }
-    const std::string name = p == park ? "park" : it->second->name;
-    if (s.cell) {
-      return fail(RTC_E_SEQUENCE,
-                  fmt::format("move({}): a cell is open: name the robot, mnp_move(robot, p)", name),
-                  Say::print);
-    }
-    if (!s.arm || !s.controlling) {
-      return fail(RTC_E_SEQUENCE,
-                  fmt::format("move({}): call rccl_open() and rccl_control() before move()", name),
-                  Say::print);
-    }
-    if (!s.robot->session->controlling()) return control_ended("move(" + name + ")");
-    const rc::PositionPtr& target = p == park ? s.arm->park() : it->second->position;
-    s.arm->set_mode(s.settings.mode);
-    s.arm->set_velocity(s.settings.translation_m_per_s, s.settings.rotation_rad_per_s);
-    s.arm->set_segment_time(s.settings.segment_time_s);
-    s.arm->set_transition_time(s.settings.transition_time_s);
+    PositionBox* box = p == park ? nullptr : position_of(p, "move");
+    if (p != park && box == nullptr) return rtc_error;
+    const std::string name = p == park ? "park" : box->name;
+    if (const int c = check_can_move(s, "move(" + name + ")"); c != RTC_OK) return c;
+    if (p == park) box = &park_position(s);
+    take_nextmove();
+    const rc::PositionPtr target = build_position(*box, s.displacement);
+    apply_settings(s);
     const rc::Motion m = s.arm->move(target);
+    s.displacement = math::Transform::identity();
+    box->queued.push_back(target);
     s.motion_names[m.id] = name;
+    s.motion_boxes[m.id] = box;
     refresh();
     return RTC_OK;
   });
-  // A 1986 program does not look at move()'s result: rccl_close() will tell.
-  State& s = state();
-  if (code != RTC_OK && s.robot && ++s.refused_moves == 1) {
-    s.first_refusal_code = code;
-    try {
-      s.first_refusal = rtc_error_message();
-    } catch (...) {
+  note_refusal(code);
+  return code;
+}
+
+int stop(double ms) {
+  const int code = guarded("stop", Say::print, RTC_E_ARGUMENT, [&] {
+    State& s = state();
+    if (!(ms > 0.0) || !std::isfinite(ms)) {
+      return fail(RTC_E_ARGUMENT, fmt::format("stop({}): the time is > 0 ms", ms), Say::print);
+    }
+    if (const int c = check_can_move(s, fmt::format("stop({})", ms)); c != RTC_OK) return c;
+    apply_settings(s);
+    const rc::Motion m = s.arm->dwell(ms * 1e-3);
+    s.motion_names[m.id] = fmt::format("stop {} ms", ms);
+    refresh();
+    return RTC_OK;
+  });
+  note_refusal(code);
+  return code;
+}
+
+int distance(const char* what, ...) {
+  std::va_list ap;
+  va_start(ap, what);
+  // Read every value before anything can throw (at most one per word of `what`).
+  std::array<double, 16> values{};
+  std::size_t words = 0;
+  const std::string text = what != nullptr ? what : "";
+  {
+    bool in_word = false;
+    for (const char c : text) {
+      const bool sep = c == ' ' || c == ',' || c == '\t';
+      if (!sep && !in_word && words < values.size()) values[words++] = va_arg(ap, double);
+      in_word = !sep;
     }
   }
-  return code;
+  va_end(ap);
+  return guarded("distance", Say::print, RTC_E_ARGUMENT, [&] {
+    State& s = state();
+    math::Transform trans = math::Transform::identity();
+    math::Rot3 rotation = math::Rot3::identity();
+    std::size_t k = 0;
+    std::string word;
+    const auto take = [&](const std::string& w) {
+      if (w.empty()) return;
+      const double v = values[k++];
+      if (!std::isfinite(v)) {
+        throw std::invalid_argument(
+            fmt::format("distance(\"{}\"): the value of {} is not finite", text, w));
+      }
+      if (w == "dx")
+        trans.p.x += v * 1e-3;
+      else if (w == "dy")
+        trans.p.y += v * 1e-3;
+      else if (w == "dz")
+        trans.p.z += v * 1e-3;
+      else if (w == "rx")
+        rotation = rotation * math::Rot3::rot_x(v * std::numbers::pi / 180.0);
+      else if (w == "ry")
+        rotation = rotation * math::Rot3::rot_y(v * std::numbers::pi / 180.0);
+      else if (w == "rz")
+        rotation = rotation * math::Rot3::rot_z(v * std::numbers::pi / 180.0);
+      else {
+        throw std::invalid_argument(fmt::format(
+            "distance(\"{}\"): unknown displacement \"{}\"; the words are dx dy dz (mm) and rx "
+            "ry rz (deg), each followed by its value (a double) among the arguments",
+            text, w));
+      }
+    };
+    if (words > 15) {
+      return fail(RTC_E_ARGUMENT, fmt::format("distance(\"{}\"): at most 15 displacements", text),
+                  Say::print);
+    }
+    for (const char c : text) {
+      if (c == ' ' || c == ',' || c == '\t') {
+        take(word);
+        word.clear();
+      } else {
+        word += c;
+      }
+    }
+    take(word);
+    if (k == 0) {
+      return fail(RTC_E_ARGUMENT, "distance: no displacement given; e.g. distance(\"dz\", -30.)",
+                  Say::print);
+    }
+    trans.R = rotation;
+    s.displacement = s.displacement * trans;
+    return RTC_OK;
+  });
 }
 
 int rccl_wait_sample(void) {
   return guarded("waitfor", Say::print, RTC_E_INTERNAL, [] {
     State& s = state();
+    take_nextmove();
     if (s.cell) return cell_wait_tick();
     if (!s.arm || !s.controlling) {
       return fail(RTC_E_SEQUENCE,
@@ -710,326 +805,118 @@ int rccl_wait_sample(void) {
     rtc::Session& session = *s.robot->session;
     if (session.controlling()) session.wait_for(session.period());
     report_failures();
+    to_c(measured_t6(s), t6_box().c);
     refresh();
     if (!session.controlling()) return control_ended("waitfor");
     return RTC_OK;
   });
 }
 
-// --- The cell
-// --------------------------------------------------------------------------------------
-
-int rccl_cell_open(const char* cell_file) {
-  return guarded("rccl_cell_open", Say::quiet, RTC_E_ROBOT, [&] {
+TRSF_PTR update(TRSF_PTR trans, POS_PTR pos) {
+  TRSF_PTR out = nullptr;
+  guarded("update", Say::print, RTC_E_ARGUMENT, [&] {
     State& s = state();
-    if (s.robot || s.cell) {
-      return fail(RTC_E_SEQUENCE,
-                  "rccl_cell_open: a session or cell is open; rccl_close() or rcclRelease() it "
-                  "first",
-                  Say::quiet);
+    PositionBox* box = position_of(pos, "update");
+    if (box == nullptr) return rtc_error;
+    TrsfBox* x = box_of(trans);
+    if (x == nullptr || x == &t6_box()) {
+      return fail(RTC_E_ARGUMENT,
+                  fmt::format("update(..., {}): the transform to solve for must be one of the "
+                              "equation's, made by newtrans or gentr_, not t6",
+                              box->name),
+                  Say::print);
     }
-    std::string path = cell_file != nullptr ? cell_file : "";
-    if (path.empty()) {
-      if (const char* env = std::getenv("RCCX_CELL"); env != nullptr) path = env;
+    if (!s.arm) {
+      return fail(RTC_E_SEQUENCE, "update: call rccl_open() first (T6 is read from the arm)",
+                  Say::print);
     }
-    if (path.empty()) {
-      // The source tree's (a build), else the installed copy.
-      std::error_code ec;
-      path =
-          std::filesystem::exists(RCCX_DEFAULT_CELL, ec) ? RCCX_DEFAULT_CELL : RCCX_INSTALLED_CELL;
+    rc::TransformPtr xt;
+    const rc::PositionPtr p = build_position(*box, math::Transform::identity(), trans, &xt);
+    if (!xt) {
+      return fail(RTC_E_ARGUMENT,
+                  fmt::format("update({}, {}): {} is not in the equation {}", x->name, box->name,
+                              x->name, p->describe()),
+                  Say::print);
     }
-    try {
-      s.cell = rccx::cell::Cell::load(path);
-    } catch (const rccx::cell::CellFileError& e) {
-      return fail(RTC_E_ROBOT, fmt::format("rccl_cell_open: {}", e.what()), Say::quiet);
-    }
-    s.cell_started = false;
-    s.refused_moves = 0;
-    s.first_refusal.clear();
-    refresh();
-    return RTC_OK;
-  });
-}
-
-MANIP* rcclCreate(const char* name, int /*flags*/) {
-  MANIP* out = nullptr;
-  guarded("rcclCreate", Say::print, RTC_E_ROBOT, [&] {
-    State& s = state();
-    if (!s.cell) {
-      return fail(RTC_E_SEQUENCE, "rcclCreate: call rccl_cell_open() first", Say::print);
-    }
-    const std::string n = name != nullptr ? name : "";
-    if (const auto it = s.manips.find(n); it != s.manips.end()) {
-      out = it->second.get();
-      return RTC_OK;
-    }
-    auto m = std::make_unique<rccl_manip>();
-    m->name = n;
-    m->arm = &s.cell->robot(n);  // std::invalid_argument names the cell's robots
-    const rccx::cell::CellRobot& cr = *s.cell->model().find_robot(n);
-    m->tool =
-        keep_transform(rc::constant(n + "_TOOL", cr.tool.value_or(math::Transform::identity())));
-    m->base_inv = keep_transform(rc::constant(n + "_BASE_INV", cr.base.inverse()));
-    m->tool_frame = keep_transform(s.cell->tool_frame(n));
-    auto park_pos = std::make_unique<PositionBox>();
-    park_pos->name = n + " park";
-    park_pos->position = m->arm->park();
-    park_pos->c.name = park_pos->name.c_str();
-    m->park = &park_pos->c;
-    s.positions.emplace(m->park, std::move(park_pos));
-    out = m.get();
-    s.manips.emplace(n, std::move(m));
+    to_c(p->solve_for(*xt, measured_t6(s)), *trans);
+    out = trans;
     return RTC_OK;
   });
   return out;
 }
 
-int rcclStart(void) {
-  return guarded("rcclStart", Say::quiet, RTC_E_INTERNAL, [] {
+int teach(TRSF_PTR trans, POS_PTR pos) {
+  int answer = NO;
+  guarded("teach", Say::print, RTC_E_ARGUMENT, [&] {
     State& s = state();
-    if (!s.cell) return fail(RTC_E_SEQUENCE, "rcclStart: call rccl_cell_open() first", Say::quiet);
-    if (s.cell_started) {
-      return fail(RTC_E_SEQUENCE, "rcclStart: the cell runs already", Say::quiet);
+    PositionBox* box = position_of(pos, "teach");
+    if (box == nullptr) return rtc_error;
+    TrsfBox* x = box_of(trans);
+    if (x == nullptr || x == &t6_box()) {
+      return fail(RTC_E_ARGUMENT,
+                  fmt::format("teach(..., {}): the transform to teach must be one of the "
+                              "equation's, made by newtrans or gentr_, not t6",
+                              box->name),
+                  Say::print);
     }
-    s.cell->start();
-    s.cell_started = true;
+    if (const int c = check_can_move(s, "teach(" + x->name + ")"); c != RTC_OK) return c;
+    rc::TransformPtr xt;
+    const rc::PositionPtr p = build_position(*box, math::Transform::identity(), trans, &xt);
+    if (!xt) {
+      return fail(RTC_E_ARGUMENT,
+                  fmt::format("teach({}, {}): {} is not in the equation {}", x->name, box->name,
+                              x->name, p->describe()),
+                  Say::print);
+    }
+    const char* env = std::getenv("RCCX_DB");
+    const std::string file = env != nullptr && env[0] != '\0' ? env : "rccx.db";
+    rc::PositionDb db(file);
+    const std::string& robot = s.arm->kinematics().model().name;
+    if (const auto stored = db.get(robot, x->name)) {
+      to_c(stored->value, *trans);
+      std::printf("teach: %s taken from the position database %s\n", x->name.c_str(), file.c_str());
+      answer = YES;
+      return RTC_OK;
+    }
+    std::printf("teach mode V1.0, transform %s, position %s\n", x->name.c_str(), box->name.c_str());
+    std::fflush(stdout);
+    rc::TeachIo io{std::cin, std::cout, &db, {}};
+    io.push = [&s](std::size_t joint, double effort) { s.robot->push(joint, effort); };
+    const rc::Taught taught = rc::teach_loop(*s.arm, io);
+    report_failures();
     refresh();
+    if (!taught.ended_by_exit || taught.termination.ended() || taught.stopped_by_signal) {
+      std::printf("teach: nothing taught for %s\n", x->name.c_str());
+      return RTC_OK;
+    }
+    const math::Transform value = p->solve_for(*xt, taught.t6);
+    rc::StoredTransform st;
+    st.robot = robot;
+    st.name = x->name;
+    st.value = value;
+    st.note = "taught for " + box->name;
+    db.put(st);
+    to_c(value, *trans);
+    answer = YES;
     return RTC_OK;
   });
+  return answer;
 }
 
-int rcclRelease(int power_off) {
-  return guarded("rcclRelease", Say::quiet, RTC_E_INTERNAL, [&] {
-    State& s = state();
-    if (!s.cell) return fail(RTC_E_SEQUENCE, "rcclRelease: no cell is open", Say::quiet);
-    struct Closer {
-      State& s;
-      ~Closer() {
-        s.cell.reset();
-        s.cell_started = false;
-        s.manips.clear();
-        for (auto& [key, box] : s.positions) box->position->pending_ends.store(0);
-        refresh();
-      }
-    } closer{s};
-    int code = RTC_OK;
-    std::string why;
-    for (auto& [name, m] : s.manips) {
-      if (s.cell_started) cell_report(*m);
-      const rtc::Termination t =
-          s.cell_started ? m->arm->stop_control() : m->arm->session().termination();
-      if (code != RTC_OK) continue;
-      const std::vector<rc::MotionEvent>& failures = m->arm->failures();
-      if (t.ended()) {
-        code = RTC_E_TERMINATED;
-        why = fmt::format("{}: {}", name, describe_end(t));
-      } else if (!failures.empty()) {
-        code = RTC_E_MOTION;
-        why = fmt::format("{}: {} motion(s) failed or were cancelled; first motion {} {}: {}", name,
-                          failures.size(), failures.front().id,
-                          rc::to_string(failures.front().kind), failures.front().message());
-      }
-    }
-    if (code == RTC_OK && s.refused_moves > 0) {
-      code = s.first_refusal_code;
-      why = fmt::format("{} mnp_move() call(s) were refused; the first: {}", s.refused_moves,
-                        s.first_refusal);
-    }
-    (void)power_off;  // the cell's robots hold; simulated arms have no power to cut
-    return code == RTC_OK ? RTC_OK : fail(code, "rcclRelease: " + why, Say::quiet);
-  });
+int comply(const char* what, ...) {
+  return fail(RTC_E_NOT_YET,
+              fmt::format("comply(\"{}\"): compliance needs force sensing, which this version "
+                          "of rccx does not have yet; the motion runs without it",
+                          what != nullptr ? what : ""),
+              Say::print);
 }
 
-int mnp_setvel(MANIP* m, double mm_per_s, double deg_per_s) {
-  rccl_manip* r = known(m);
-  if (r == nullptr) return bad_handle("mnp_setvel");
-  State& s = state();
-  const rc::MotionSettings saved = s.settings;
-  const int code = setvel(mm_per_s, deg_per_s);  // the same checks and words
-  if (code == RTC_OK) {
-    r->settings.translation_m_per_s = s.settings.translation_m_per_s;
-    r->settings.rotation_rad_per_s = s.settings.rotation_rad_per_s;
-  }
-  s.settings = saved;
-  return code;
-}
-
-int mnp_setmod(MANIP* m, int mode) {
-  rccl_manip* r = known(m);
-  if (r == nullptr) return bad_handle("mnp_setmod");
-  State& s = state();
-  const rc::MotionSettings saved = s.settings;
-  const int code = setmod(mode);
-  if (code == RTC_OK) r->settings.mode = s.settings.mode;
-  s.settings = saved;
-  return code;
-}
-
-int mnp_settime(MANIP* m, double transition_ms, double segment_ms) {
-  rccl_manip* r = known(m);
-  if (r == nullptr) return bad_handle("mnp_settime");
-  State& s = state();
-  const rc::MotionSettings saved = s.settings;
-  const int code = settime(transition_ms, segment_ms);
-  if (code == RTC_OK) {
-    r->settings.transition_time_s = s.settings.transition_time_s;
-    r->settings.segment_time_s = s.settings.segment_time_s;
-  }
-  s.settings = saved;
-  return code;
-}
-
-int mnp_move(MANIP* m, POS_PTR p) {
-  rccl_manip* r = known(m);
-  if (r == nullptr) return bad_handle("mnp_move");
-  const int code = guarded("mnp_move", Say::print, RTC_E_ARGUMENT, [&] {
-    State& s = state();
-    const auto it = p != nullptr ? s.positions.find(p) : s.positions.end();
-    if (it == s.positions.end()) {
-      return fail(RTC_E_ARGUMENT,
-                  fmt::format("mnp_move({}, {}): not a position made by makeposition() (or "
-                              "mnp_park)",
-                              r->name, static_cast<const void*>(p)),
-                  Say::print);
-    }
-    if (!s.cell_started) {
-      return fail(
-          RTC_E_SEQUENCE,
-          fmt::format("mnp_move({}, {}): call rcclStart() first", r->name, it->second->name),
-          Say::print);
-    }
-    if (!r->arm->session().controlling()) {
-      return fail(
-          RTC_E_TERMINATED,
-          fmt::format("mnp_move({}, {}): {}'s control has ended: {}", r->name, it->second->name,
-                      r->name, describe_end(r->arm->session().termination())),
-          Say::print);
-    }
-    r->arm->set_mode(r->settings.mode);
-    r->arm->set_velocity(r->settings.translation_m_per_s, r->settings.rotation_rad_per_s);
-    r->arm->set_segment_time(r->settings.segment_time_s);
-    r->arm->set_transition_time(r->settings.transition_time_s);
-    const rc::Motion mo = r->arm->move(it->second->position, r->next);
-    r->next = rc::StartWhen{};
-    r->motion_names[mo.id] = it->second->name;
-    refresh();
-    return RTC_OK;
-  });
-  State& s = state();
-  if (code != RTC_OK && ++s.refused_moves == 1) {
-    s.first_refusal_code = code;
-    try {
-      s.first_refusal = rtc_error_message();
-    } catch (...) {
-    }
-  }
-  return code;
-}
-
-int mnp_last_motion(const MANIP* m) {
-  const rccl_manip* r = known(m);
-  return r == nullptr ? 0 : static_cast<int>(r->arm->last_queued());
-}
-
-int mnp_after(MANIP* m, MANIP* other, int motion, int event) {
-  rccl_manip* r = known(m);
-  rccl_manip* o = known(other);
-  if (r == nullptr || o == nullptr) return bad_handle("mnp_after");
-  return guarded("mnp_after", Say::print, RTC_E_ARGUMENT, [&] {
-    if (event != RCCL_START && event != RCCL_END) {
-      return fail(RTC_E_ARGUMENT,
-                  fmt::format("mnp_after({}, {}, {}, {}): the event is RCCL_START or RCCL_END",
-                              r->name, o->name, motion, event),
-                  Say::print);
-    }
-    if (motion < 1 || static_cast<std::uint64_t>(motion) > o->arm->last_queued()) {
-      return fail(RTC_E_ARGUMENT,
-                  fmt::format("mnp_after({}, {}, {}): {} has queued {}; take the number "
-                              "from mnp_last_motion() after its mnp_move",
-                              r->name, o->name, motion, o->name,
-                              o->arm->last_queued() == 0
-                                  ? std::string("no motion yet")
-                                  : fmt::format("motions 1 .. {}", o->arm->last_queued())),
-                  Say::print);
-    }
-    if (r->next.after.size() >= rc::StartWhen::kMaxGates) {
-      return fail(RTC_E_ARGUMENT,
-                  fmt::format("mnp_after({}): a motion waits for at most {} events", r->name,
-                              rc::StartWhen::kMaxGates),
-                  Say::print);
-    }
-    const rc::Motion mo{static_cast<std::uint64_t>(motion)};
-    r->next.after.push_back(
-        state().cell->event(o->name, event == RCCL_START ? mo.start() : mo.end()));
-    return RTC_OK;
-  });
-}
-
-int rccl_together(int end_together, ...) {
-  std::array<MANIP*, rc::Rendezvous::kMaxParticipants + 1> list{};
-  std::size_t n = 0;
-  std::va_list ap;
-  va_start(ap, end_together);
-  for (; n < list.size(); ++n) {
-    list[n] = va_arg(ap, MANIP*);
-    if (list[n] == nullptr) break;
-  }
-  va_end(ap);
-  return guarded("rccl_together", Say::print, RTC_E_ARGUMENT, [&] {
-    State& s = state();
-    if (n == list.size()) {
-      return fail(RTC_E_ARGUMENT,
-                  "rccl_together: more than 64 robots: is the NULL that ends the list missing?",
-                  Say::print);
-    }
-    std::vector<std::string> names;
-    for (std::size_t i = 0; i < n; ++i) {
-      const rccl_manip* r = known(list[i]);
-      if (r == nullptr) return bad_handle("rccl_together");
-      names.push_back(r->name);
-    }
-    if (!s.cell) return fail(RTC_E_SEQUENCE, "rccl_together: no cell is open", Say::print);
-    const rccx::cell::Together t = s.cell->together(names, end_together != 0);
-    for (std::size_t i = 0; i < n; ++i) {
-      rccl_manip* r = known(list[i]);
-      r->next.together = t.rendezvous;
-      r->next.slot = i;
-    }
-    return RTC_OK;
-  });
-}
-
-int mnp_started(const MANIP* m, int motion) {
-  const rccl_manip* r = known(m);
-  if (r == nullptr || motion < 0) return 0;
-  return r->arm->happened(rc::Motion{static_cast<std::uint64_t>(motion)}.start()) ? 1 : 0;
-}
-
-int mnp_ended(const MANIP* m, int motion) {
-  const rccl_manip* r = known(m);
-  if (r == nullptr || motion < 0) return 0;
-  return r->arm->happened(rc::Motion{static_cast<std::uint64_t>(motion)}.end()) ? 1 : 0;
-}
-
-int mnp_completed(const MANIP* m) {
-  const rccl_manip* r = known(m);
-  return r != nullptr && r->arm->happened(rc::Manipulator::completed()) ? 1 : 0;
-}
-
-POS_PTR mnp_park(MANIP* m) {
-  return member_of(m, "mnp_park", &rccl_manip::park);
-}
-
-TRSF_PTR mnp_tool(MANIP* m) {
-  return member_of(m, "mnp_tool", &rccl_manip::tool);
-}
-
-TRSF_PTR mnp_base_inv(MANIP* m) {
-  return member_of(m, "mnp_base_inv", &rccl_manip::base_inv);
-}
-
-TRSF_PTR mnp_tool_frame(MANIP* leader) {
-  return member_of(leader, "mnp_tool_frame", &rccl_manip::tool_frame);
+int lock(const char* what) {
+  return fail(RTC_E_NOT_YET,
+              fmt::format("lock(\"{}\"): compliance (comply / lock) is not in this version of "
+                          "rccx yet; nothing changed",
+                          what != nullptr ? what : ""),
+              Say::print);
 }
 
 }  // extern "C"

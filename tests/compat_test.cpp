@@ -65,7 +65,7 @@ TEST_F(Compat, BadArgumentsAreRefused) {
   EXPECT_EQ(settime(0, 0), RTC_E_ARGUMENT);
   EXPECT_EQ(settime(100, -1), RTC_E_ARGUMENT);
   EXPECT_EQ(move(nullptr), RTC_E_ARGUMENT);
-  POS not_made_here{0, "fake"};
+  POS not_made_here{0, "fake", 0};
   EXPECT_EQ(move(&not_made_here), RTC_E_ARGUMENT);
   EXPECT_EQ(setvel(100, 100), RTC_OK);  // the defaults, for the tests after this one
   EXPECT_EQ(setmod('j'), RTC_OK);
@@ -88,7 +88,8 @@ TEST_F(Compat, CallsOutOfOrderAreSequenceErrors) {
   EXPECT_EQ(rccl_control(), RTC_E_SEQUENCE);
   // The refused move() makes the session fail, for programs that check only rccl_close().
   EXPECT_EQ(rccl_close(0), RTC_E_SEQUENCE);
-  EXPECT_NE(message().find("1 move() call(s) were refused"), std::string::npos) << message();
+  EXPECT_NE(message().find("1 call(s) to queue a motion were refused"), std::string::npos)
+      << message();
   EXPECT_EQ(rccl_close(0), RTC_E_SEQUENCE);  // closed all the same
   EXPECT_NE(message().find("no session is open"), std::string::npos) << message();
 }

@@ -661,13 +661,38 @@ void TrajectoryGenerator::emit(EventKind kind, std::uint64_t id, const SampleCon
   events_.push(e);  // a full event queue drops the event: the counters still tell the story
 }
 
-void TrajectoryGenerator::end_motion(const Segment& s, const SampleContext& ctx) noexcept {
+void TrajectoryGenerator::end_motion(const Segment& s, const SampleContext& ctx,
+                                     std::string_view text) noexcept {
   if (s.id == 0) return;
   SegmentReport& rep = reports_[s.id % kReports];
   if (rep.id == s.id) rep.end_s = ctx.t_s;
   if (s.position != nullptr) s.position->pending_ends.fetch_sub(1, std::memory_order_acq_rel);
-  emit(EventKind::ended, s.id, ctx);
+  emit(EventKind::ended, s.id, ctx, kin::IkStatus::ok, 0, text);
   ledger_.mark_ended(s.id);
+}
+
+void TrajectoryGenerator::next_motion(const SampleContext& ctx) noexcept {
+  const bool moving = tr_.active || (cur_.kind != Segment::Kind::rest && !cur_.resting);
+  if (halt_.active || !moving) return;
+  if (tr_.active && tr_.to_next) {
+    // Between two motions: the one ending and the one beginning both end here.
+    end_motion(cur_, ctx, kNextmoveText);
+    end_motion(next_, ctx, kNextmoveText);
+  } else {
+    if (cur_.kind != Segment::Kind::rest && !cur_.resting) end_motion(cur_, ctx, kNextmoveText);
+    if (has_next_ && joined_) {
+      // Joined but not begun: it starts from rest once the arm has stopped, before the
+      // request taken after it.
+      if (waiting_) requeued_ = waiting_;
+      waiting_ = joined_;
+      rendezvous_ready_ = false;
+    }
+  }
+  joined_.reset();
+  has_next_ = false;
+  tr_.active = false;
+  cur_.id = 0;
+  start_halt();
 }
 
 void TrajectoryGenerator::fail(std::uint64_t id, const SampleContext& ctx, kin::IkStatus status,
@@ -695,6 +720,15 @@ void TrajectoryGenerator::fail(std::uint64_t id, const SampleContext& ctx, kin::
     withdraw_from(*waiting_, text);
     waiting_.reset();
   }
+  if (requeued_) {
+    Segment w;
+    w.id = requeued_->id;
+    w.position = requeued_->position;
+    cancel(w);
+    withdraw_from(*requeued_, text);
+    requeued_.reset();
+  }
+  joined_.reset();
   MotionRequest r;
   while (requests_.pop(r)) {
     Segment w;
@@ -838,7 +872,11 @@ void TrajectoryGenerator::withdraw_from(const MotionRequest& r, const Text& why)
 
 void TrajectoryGenerator::reset(const JointVector& q, double t_s) noexcept {
   if (waiting_) withdraw_from(*waiting_, text("its robot's control started again"));
+  if (requeued_) withdraw_from(*requeued_, text("its robot's control started again"));
   waiting_.reset();
+  requeued_.reset();
+  joined_.reset();
+  next_requested_.store(false);
   rendezvous_ready_ = false;
   has_next_ = false;
   tr_ = Transition{};
@@ -851,7 +889,7 @@ void TrajectoryGenerator::reset(const JointVector& q, double t_s) noexcept {
 }
 
 bool TrajectoryGenerator::at_rest() const noexcept {
-  return !halt_.active && !tr_.active && !has_next_ && !waiting_ &&
+  return !halt_.active && !tr_.active && !has_next_ && !waiting_ && !requeued_ &&
          (cur_.kind == Segment::Kind::rest || cur_.resting);
 }
 
@@ -878,9 +916,14 @@ std::uint64_t TrajectoryGenerator::step(const SampleContext& ctx, const JointVec
       start_halt();
     }
   }
+  if (next_requested_.exchange(false, std::memory_order_acq_rel)) next_motion(ctx);
   if (!waiting_) {
     MotionRequest r;
-    if (requests_.pop(r)) {
+    if (requeued_) {
+      waiting_ = requeued_;
+      requeued_.reset();
+      rendezvous_ready_ = false;
+    } else if (requests_.pop(r)) {
       waiting_ = r;
       rendezvous_ready_ = false;
     }
@@ -909,6 +952,7 @@ std::uint64_t TrajectoryGenerator::step(const SampleContext& ctx, const JointVec
                             (waiting_->gates == 0 || gate_state(why) == GateState::open);
       if (!has_next_ && may_join && t < te - cur_.stop_tau - eps) {
         if (build(*waiting_, ctx, te)) {
+          joined_ = waiting_;
           waiting_.reset();
           const Blend blend = blend_between(cur_, &next_);
           next_tau_ = transition_tau(cur_, next_, blend, te, ctx);

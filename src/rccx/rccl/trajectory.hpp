@@ -80,6 +80,8 @@ enum class EventKind : std::uint8_t { started, ended, failed, cancelled };
 std::string_view to_string(EventKind k) noexcept;
 
 inline constexpr std::size_t kEventText = 240;
+/// The text of the `ended` event of a motion that request_next() ended before its goal.
+inline constexpr std::string_view kNextmoveText = "ended by nextmove";
 
 /// What the generator tells the planning level.
 struct MotionEvent {
@@ -145,6 +147,11 @@ class TrajectoryGenerator {
   std::optional<MotionEvent> next_event() noexcept;
   /// Asks the loop to stop smoothly where it is and cancel everything queued.
   void request_halt() noexcept { halt_requested_.store(true, std::memory_order_release); }
+  /// RCCL's nextmove (a guarded motion): ends the motion running now where the arm is. The
+  /// arm stops smoothly (every joint within its acceleration bound, as a halt), that motion
+  /// ends with the event text kNextmoveText (not a failure), and the queue goes on from rest
+  /// there. Nothing happens at rest. May be called from any thread, the loop's included.
+  void request_next() noexcept { next_requested_.store(true, std::memory_order_release); }
   /// Highest id started / ended (ended includes failed and cancelled), in queue order.
   [[nodiscard]] std::uint64_t started_upto() const noexcept { return ledger_.started_upto(); }
   [[nodiscard]] std::uint64_t ended_upto() const noexcept { return ledger_.ended_upto(); }
@@ -270,7 +277,9 @@ class TrajectoryGenerator {
   void emit(EventKind kind, std::uint64_t id, const SampleContext& ctx,
             kin::IkStatus status = kin::IkStatus::ok, int joint = 0,
             std::string_view text = {}) noexcept;
-  void end_motion(const Segment& s, const SampleContext& ctx) noexcept;
+  void end_motion(const Segment& s, const SampleContext& ctx, std::string_view text = {}) noexcept;
+  /// request_next(): ends the motion running now and stops where the arm is.
+  void next_motion(const SampleContext& ctx) noexcept;
   void fail(std::uint64_t id, const SampleContext& ctx, kin::IkStatus status, int joint,
             const Text& text) noexcept;
   void start_halt() noexcept;
@@ -286,6 +295,7 @@ class TrajectoryGenerator {
   boost::lockfree::spsc_queue<MotionRequest, boost::lockfree::capacity<kQueueCapacity>> requests_;
   boost::lockfree::spsc_queue<MotionEvent, boost::lockfree::capacity<4 * kQueueCapacity>> events_;
   std::atomic<bool> halt_requested_{false};
+  std::atomic<bool> next_requested_{false};
   bool stop_requested_ = false;  ///< request_stop(): same thread as step()
   Text stop_text_{};
   std::array<SegmentReport, kReports> reports_{};
@@ -295,7 +305,10 @@ class TrajectoryGenerator {
   bool has_next_ = false;
   double next_tau_ = 0.0;                 ///< half the transition from cur_ into next_, s
   std::optional<MotionRequest> waiting_;  ///< taken from the queue, not yet built
-  bool rendezvous_ready_ = false;         ///< waiting_ has told its rendezvous it is ready
+  /// The request next_ was built from when it joined cur_ (request_next() puts it back), and a
+  /// request put back in front of the queue.
+  std::optional<MotionRequest> joined_, requeued_;
+  bool rendezvous_ready_ = false;  ///< waiting_ has told its rendezvous it is ready
   Transition tr_;
   Halt halt_;
   kin::JointVector last_q_, prev_q_;  ///< the last two setpoints

@@ -1,0 +1,187 @@
+// What the files of rccx's C layer (rccl.h, rtc.h) share: the state of the one session or
+// cell a C program drives, the boxes behind its TRSF and POS pointers, and error reporting.
+// Not installed. rccx's headers come first and the C headers last, so that the C macros (EQ,
+// TL, Rot, waitfor, ...) never reach rccx's headers; the C names (move, stop, park, t6, ...)
+// are why these files write std::move.
+#pragma once
+
+#include <fmt/format.h>
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <initializer_list>
+#include <map>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "rccx/cell/cell.hpp"
+#include "rccx/kinematics/robot_model.hpp"
+#include "rccx/math/transform.hpp"
+#include "rccx/rccl/manipulator.hpp"
+#include "rccx/rccl/position.hpp"
+#include "rccx/rccl/transforms.hpp"
+#include "rccx/rtc/sample_log.hpp"
+#include "rccx/rtc/session.hpp"
+#include "rccx/rtc/simulated_robot.hpp"
+
+// clang-format off
+#include "rccl.h"
+#include "rtc.h"
+// clang-format on
+
+/// What a MANIP points to: a robot of the open cell and its own settings.
+struct rccl_manip {
+  std::string name;
+  rccx::rccl::Manipulator* arm = nullptr;
+  rccx::rccl::MotionSettings settings;  ///< mnp_setvel, mnp_setmod, mnp_settime
+  rccx::rccl::StartWhen next;           ///< mnp_after / rccl_together, for the next mnp_move
+  POS* park = nullptr;
+  TRSF_PTR tool = nullptr, base_inv = nullptr, tool_frame = nullptr;
+  std::size_t failures_seen = 0;
+  bool told_ended = false;
+  std::map<std::uint64_t, std::string> motion_names;
+};
+
+namespace rccx::compat {
+
+namespace math = rccx::math;
+namespace kin = rccx::kin;
+namespace rtc = rccx::rtc;
+namespace rc = rccx::rccl;
+
+/// What a named TRSF (newtrans, gentr_*, t6, a cell's) is behind its C struct.
+struct TrsfBox {
+  TRSF c{};  ///< what the program sees; c.rccx points back here
+  std::string name;
+  /// The transform the sample loop evaluates for varb, functional and system transforms (t6:
+  /// rc::t6()); null for const and hold, whose value is read at each move().
+  rc::TransformPtr live;
+  /// RCCL_SYSTEM: rccx's transform the live one copies into c at each sample.
+  rc::TransformPtr source;
+  math::Transform last_good;  ///< functional: the last value that was finite (loop side)
+};
+
+/// A position the C program holds: the POS it sees and the equation behind it.
+struct PositionBox {
+  POS c{1, nullptr, 0};
+  POS* shown = &c;  ///< the POS the program holds (park: the global one)
+  std::string name;
+  std::vector<TRSF*> lhs, rhs;  ///< as written; t6 among lhs
+  TRSF* tool = nullptr;
+  rc::PositionPtr joints;  ///< a position given in joints (park): no equation
+  /// Each move() builds a position from the transforms' values then; those not ended yet.
+  std::vector<rc::PositionPtr> queued;
+};
+
+/// Everything the C calls share. Members are destroyed in reverse order: the manipulator
+/// before the robot whose session it uses, both before the positions and transforms.
+struct State {
+  std::map<const TRSF*, std::unique_ptr<TrsfBox>> transforms;
+  std::map<const POS*, std::unique_ptr<PositionBox>> positions;
+  rc::MotionSettings settings;  ///< setvel, setmod, settime: applied at each move()
+  std::string configuration;    ///< setconf, as letters ("" keeps the present one)
+  math::Transform displacement = math::Transform::identity();  ///< distance(), for the next move
+  std::unique_ptr<rtc::SimulatedRobot> robot;
+  std::unique_ptr<rc::Manipulator> arm;
+  bool controlling = false;  ///< rccl_control() was called in this session
+  bool told_ended = false;   ///< the end of control was printed
+  std::size_t failures_seen = 0;
+  std::size_t refused_moves = 0;  ///< move() calls that failed in this session
+  int first_refusal_code = RTC_OK;
+  std::string first_refusal;
+  std::map<std::uint64_t, std::string> motion_names;   ///< motion id -> position name
+  std::map<std::uint64_t, PositionBox*> motion_boxes;  ///< motion id -> its position
+  std::string message;                                 ///< the last error's
+  // A cell (rccl_cell_open): declared last, so that it stops before the positions and
+  // transforms its generators point to go.
+  std::map<std::string, std::unique_ptr<rccl_manip>, std::less<>> manips;
+  std::unique_ptr<rccx::cell::Cell> cell;
+  bool cell_started = false;
+};
+
+State& state();
+TrsfBox& t6_box();
+POS& park_box();
+
+enum class Say : bool { quiet, print };
+
+/// Records an error: rtc_error, the message, and (Say::print) a line on stderr.
+int fail(int code, std::string_view text, Say say) noexcept;
+
+/// Runs `body` (which returns an error code); an exception becomes an error code. `invalid` is
+/// the code for std::invalid_argument, whose meaning depends on the call.
+template <class F>
+int guarded(const char* call, Say say, int invalid, F&& body) noexcept {
+  const auto failed = [&](int code, const char* what) noexcept {
+    try {
+      return fail(code, fmt::format("{}: {}", call, what), say);
+    } catch (...) {
+      return fail(code, what, say);
+    }
+  };
+  try {
+    return body();
+  } catch (const rc::EquationError& e) {
+    return failed(RTC_E_EQUATION, e.what());
+  } catch (const rc::MotionError& e) {
+    return failed(RTC_E_UNREACHABLE, e.what());
+  } catch (const kin::RobotFileError& e) {
+    return failed(RTC_E_ROBOT, e.what());
+  } catch (const rtc::LogError& e) {
+    return failed(RTC_E_OPEN, e.what());
+  } catch (const rtc::SessionError& e) {
+    return failed(RTC_E_OPEN, e.what());
+  } catch (const std::invalid_argument& e) {
+    return failed(invalid, e.what());
+  } catch (const std::exception& e) {
+    return failed(RTC_E_INTERNAL, e.what());
+  } catch (...) {
+    return failed(RTC_E_INTERNAL, "an unknown exception");
+  }
+}
+
+bool finite(std::initializer_list<double> values) noexcept;
+
+/// A TRSF's value in rccx's units (mm to m), and back.
+math::Transform to_math(const TRSF& t) noexcept;
+void to_c(const math::Transform& value, TRSF& t) noexcept;
+VECT to_c(const math::Vec3& v) noexcept;
+math::Vec3 to_math(const VECT& v) noexcept;
+
+/// The box of a TRSF made here (newtrans, gentr_*, t6, a cell's), or null.
+TrsfBox* box_of(const TRSF* t) noexcept;
+/// Registers rccx's transform `source` as a named TRSF: constants as RCCL_CONST (their value
+/// copied), others as RCCL_SYSTEM (copied into the struct at every sample).
+TRSF_PTR keep_transform(const rc::TransformPtr& source);
+
+/// The rccx transform standing for `b` in a position built now: constants and holds at their
+/// present values (`as_hold`: as a hold transform, so that it stays a factor of its own for
+/// update()), the live transform for the others.
+rc::TransformPtr transform_now(TrsfBox& b, bool as_hold);
+
+/// The position `p` with the values its const and hold transforms have now, and `extra` (a
+/// displacement from distance()) after its right side. `x` (may be null) is built as a hold
+/// and returned in `x_out`.
+rc::PositionPtr build_position(const PositionBox& p, const math::Transform& extra,
+                               const TRSF* x = nullptr, rc::TransformPtr* x_out = nullptr);
+
+/// Brings POS.end, POS.code, `completed` and t6's value up to date with the generators.
+void refresh() noexcept;
+/// Prints the motions of the one-robot session that failed since the last call.
+void report_failures();
+/// The robot for rccl_open / RCCX_ROBOT.
+kin::RobotModel choose_robot(const char* robot);
+/// waitfor() with a cell: one tick of the cell's clock.
+int cell_wait_tick();
+/// How a control session ended, for messages.
+std::string describe_end(const rtc::Termination& t);
+/// Applies the planning side of `nextmove` (a program that set it between samples).
+void take_nextmove() noexcept;
+/// Called in the sample loop after a transform's function ran: acts on `nextmove`.
+void loop_nextmove() noexcept;
+
+}  // namespace rccx::compat
