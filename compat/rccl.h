@@ -129,6 +129,13 @@ extern TRSF_PTR const t6;
  * program ends.
  */
 TRSF_PTR rccl_newtrans(const char* name, int type, RCCL_FN fn);
+#ifdef __cplusplus
+#define RCCL_FN_CAST(f) reinterpret_cast<RCCL_FN>(f)
+#define RCCL_FN_NULL nullptr
+#else
+#define RCCL_FN_CAST(f) ((RCCL_FN)(f))
+#define RCCL_FN_NULL ((RCCL_FN)0)
+#endif
 /* Variadic macros are C99 (and GNU C89): say so to a -pedantic gnu89 build only once, here. */
 #if defined(__GNUC__)
 #pragma GCC diagnostic push
@@ -148,23 +155,24 @@ TRSF_PTR rccl_newtrans(const char* name, int type, RCCL_FN fn);
 #define RCCL_NT_TYPE_hold ~, RCCL_HOLD
 #define RCCL_NT_TYPE_HOLD ~, RCCL_HOLD
 #define RCCL_NT_TYPE_RCCL_HOLD ~, RCCL_HOLD
-#define RCCL_NT_FN_const ~, (RCCL_FN)0
-#define RCCL_NT_FN_CONST ~, (RCCL_FN)0
-#define RCCL_NT_FN_RCCL_CONST ~, (RCCL_FN)0
-#define RCCL_NT_FN_varb ~, (RCCL_FN)0
-#define RCCL_NT_FN_VARB ~, (RCCL_FN)0
-#define RCCL_NT_FN_RCCL_VARB ~, (RCCL_FN)0
-#define RCCL_NT_FN_hold ~, (RCCL_FN)0
-#define RCCL_NT_FN_HOLD ~, (RCCL_FN)0
-#define RCCL_NT_FN_RCCL_HOLD ~, (RCCL_FN)0
+#define RCCL_NT_FN_const ~, RCCL_FN_NULL
+#define RCCL_NT_FN_CONST ~, RCCL_FN_NULL
+#define RCCL_NT_FN_RCCL_CONST ~, RCCL_FN_NULL
+#define RCCL_NT_FN_varb ~, RCCL_FN_NULL
+#define RCCL_NT_FN_VARB ~, RCCL_FN_NULL
+#define RCCL_NT_FN_RCCL_VARB ~, RCCL_FN_NULL
+#define RCCL_NT_FN_hold ~, RCCL_FN_NULL
+#define RCCL_NT_FN_HOLD ~, RCCL_FN_NULL
+#define RCCL_NT_FN_RCCL_HOLD ~, RCCL_FN_NULL
 #define newtrans(name, type)                                          \
   rccl_newtrans((name), RCCL_NT_2ND_(RCCL_NT_TYPE_##type, RCCL_FUNCT, ~), \
-                RCCL_NT_2ND_(RCCL_NT_FN_##type, (RCCL_FN)(type), ~))
+                RCCL_NT_2ND_(RCCL_NT_FN_##type, RCCL_FN_CAST(type), ~))
 
 /**
- * Functions of functionally defined transforms may read these: the time of the sample being
- * computed, in ms since rccl_control() (rtime), and its number (rccl_sample, 1, 2, ...).
- * Between samples they hold the last sample's.
+ * The time in ms since rccl_open() (rtime) and the sample number (rccl_sample, 1, 2, ...). In a
+ * transform's function: the time the setpoint being computed is for, and the sample computing
+ * it. In the program, after each wait: the time and number of the arm's last reading (the
+ * setpoints run a sample or two ahead of it, the arm's pipeline).
  */
 extern long rtime;
 extern long rccl_sample;

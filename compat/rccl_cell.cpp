@@ -2,6 +2,7 @@
 // the mnp_ calls, rccl_together. Positions and transforms are shared with the one-robot calls
 // (compat_internal.hpp); waitfor() lets one tick of the cell's clock run.
 #include <array>
+#include <cmath>
 #include <cstdarg>
 #include <cstdio>
 #include <cstdlib>
@@ -89,6 +90,11 @@ int cell_wait_tick() {
   if (any) s.cell->wait_for(s.cell->group().period());
   bool all_ended = true;
   for (auto& [name, m] : s.manips) all_ended = cell_report(*m) && all_ended;
+  if (!s.manips.empty()) {
+    const rtc::How how = s.manips.begin()->second->arm->session().how();
+    rtime = std::lround(how.time_s * 1e3);
+    rccl_sample = static_cast<long>(how.sample);
+  }
   refresh();
   if (all_ended) {
     return fail(RTC_E_TERMINATED, "waitfor: every robot's control has ended; rcclRelease()",

@@ -536,6 +536,7 @@ int rccl_open(const char* robot, double period_ms) {
     s.motion_names.clear();
     s.motion_boxes.clear();
     s.displacement = math::Transform::identity();
+    s.configuration.clear();  // letters of the last session's robot
     nextmove = 0;
     loop_saw_nextmove = false;
     park_position(s);
@@ -805,7 +806,10 @@ int rccl_wait_sample(void) {
     rtc::Session& session = *s.robot->session;
     if (session.controlling()) session.wait_for(session.period());
     report_failures();
-    to_c(measured_t6(s), t6_box().c);
+    const rtc::How how = session.how();
+    rtime = std::lround(how.time_s * 1e3);
+    rccl_sample = static_cast<long>(how.sample);
+    to_c(s.arm->kinematics().forward(how.q()), t6_box().c);
     refresh();
     if (!session.controlling()) return control_ended("waitfor");
     return RTC_OK;
