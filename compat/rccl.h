@@ -102,7 +102,9 @@ typedef struct trsf {
 
 /**
  * T6: the pose of the robot's last link in its base frame, the unknown of every position
- * equation. Its n, o, a, p hold the measured T6 after each sample a wait lets run.
+ * equation. Its n, o, a, p hold the measured T6 (mm) after each sample a wait lets run, and, in
+ * the functions of functionally defined transforms, the T6 measured at the sample being
+ * computed (one robot's session; in a cell, only after waits: use mnp_ calls there).
  */
 extern TRSF_PTR const t6;
 

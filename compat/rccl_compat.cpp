@@ -537,6 +537,7 @@ int rccl_open(const char* robot, double period_ms) {
     s.motion_boxes.clear();
     s.displacement = math::Transform::identity();
     s.configuration.clear();  // letters of the last session's robot
+    t6_box().c.age = -1;
     nextmove = 0;
     loop_saw_nextmove = false;
     park_position(s);

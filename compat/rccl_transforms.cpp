@@ -27,11 +27,25 @@ void note_sample(const rc::SampleContext& ctx) noexcept {
   rccl_sample = static_cast<long>(ctx.sample);
 }
 
+/// t6's value for the functions of this sample: the arm's measured T6 (a monitor's sensor),
+/// computed once a sample.
+void measured_t6_in_loop(const rc::SampleContext& ctx) noexcept {
+  TrsfBox& t6b = t6_box();
+  const long sample = static_cast<long>(ctx.sample);
+  if (t6b.c.age == sample) return;
+  const State& s = state();
+  const kin::Kinematics* k = s.arm ? &s.arm->kinematics() : nullptr;
+  if (k == nullptr || ctx.how->dof != k->dof()) return;  // a cell: several arms, no one T6
+  to_c(k->forward(ctx.how->q()), t6b.c);
+  t6b.c.age = sample;
+}
+
 /// A functional's value: the struct after its function ran this sample; the last finite value
 /// when the function left something that is not a number (what the arm should not follow).
 math::Transform functional_value(TrsfBox& b, const rc::SampleContext& ctx) {
   if (ctx.how != nullptr) {  // in the sample loop (the planning level reads the value as it is)
     note_sample(ctx);
+    measured_t6_in_loop(ctx);
     reinterpret_cast<TransformFn>(b.c.fn)(&b.c);
     b.c.age = static_cast<long>(ctx.sample);
     loop_nextmove();

@@ -1,0 +1,57 @@
+/*
+ * teach_then_use.c: a grasp taught by hand with teach(), then used, in the manual's style, on
+ * the simulated Microbo.
+ *
+ * teach(grasp, pos) first looks GRASP up in the position database (RCCX_DB, default rccx.db):
+ * when it is there, it is used at once. Otherwise the teach loop runs on the terminal: move the
+ * arm (`?` lists the commands), `e` records where it is, GRASP is solved so that the equation
+ * T6 = OVER GRASP holds there, and stored. The program then leaves and comes back to the
+ * taught place, and exits 1 if it comes back more than 2 mm off.
+ *
+ *   cc teach_then_use.c $(pkg-config --cflags --libs rccx-compat) && ./a.out
+ */
+#include <stdio.h>
+#include "rccl.h"
+#include "rtc.h"
+
+int main()
+{
+  TRSF_PTR over, grasp;
+  POS_PTR above, pos;
+  TRSF taught;
+  VECT d;
+
+  over = gentr_rot("OVER", 300., 100., 260., xunit, 180.);
+  grasp = newtrans("GRASP", hold);
+  above = makeposition("ABOVE", t6, EQ, over, TL, t6);
+  pos = makeposition("POS", t6, EQ, over, grasp, TL, t6);
+
+  if (rccl_open(0, 0) || rccl_control()) {
+    print_rtc_error(rtc_error, 0);
+    return 1;
+  }
+  move(above);
+  stop(500.); /* the wrist's joints settle a few hundred ms after the setpoint arrives */
+  waitfor(completed);
+  if (teach(grasp, pos) == NO) {
+    printf("nothing taught\n");
+    rccl_close(0);
+    return 1;
+  }
+  printr(grasp, stdout);
+  trmult(&taught, over, grasp);
+  move(park);
+  move(pos);
+  waitfor(pos->end);
+  stop(300.);
+  waitfor(completed);
+  vecsub(&d, &t6->p, &taught.p);
+  printf("back at the taught place, off by %.2f mm\n", norm(&d));
+  move(park);
+  waitfor(completed);
+  if (rccl_close(0)) {
+    print_rtc_error(rtc_error, 0);
+    return 1;
+  }
+  return norm(&d) < 2. ? 0 : 1;
+}

@@ -1,0 +1,38 @@
+# Runs one program of examples/c on its simulated robot with RCCX_LOG set, and checks that it
+# exits 0 (each program checks the geometry it asked for and exits 1 when it is off), prints
+# what EXPECT matches, and logged samples.
+#   cmake -DPROG=path -DLOG=out.csv -DEXPECT=regex [-DINPUT=file] [-DDB=file] [-DFRESH_DB=ON]
+#         -P c_example_test.cmake
+foreach(var PROG LOG EXPECT)
+  if(NOT DEFINED ${var})
+    message(FATAL_ERROR "c_example_test.cmake needs -D${var}=...")
+  endif()
+endforeach()
+file(REMOVE "${LOG}")
+set(ENV{RCCX_LOG} "${LOG}")
+if(DEFINED DB)
+  if(FRESH_DB)
+    file(REMOVE "${DB}")
+  endif()
+  set(ENV{RCCX_DB} "${DB}")
+endif()
+if(NOT DEFINED INPUT)
+  set(INPUT /dev/null)
+endif()
+execute_process(COMMAND "${PROG}" INPUT_FILE "${INPUT}" RESULT_VARIABLE rc OUTPUT_VARIABLE out
+                ERROR_VARIABLE err TIMEOUT 600)
+message(STATUS "stdout:\n${out}")
+if(NOT err STREQUAL "")
+  message(STATUS "stderr:\n${err}")
+endif()
+if(NOT rc STREQUAL "0")
+  message(FATAL_ERROR "${PROG} exited with ${rc}")
+endif()
+if(NOT out MATCHES "${EXPECT}")
+  message(FATAL_ERROR "${PROG} did not print what matches \"${EXPECT}\"")
+endif()
+file(STRINGS "${LOG}" rows)
+list(LENGTH rows n)
+if(n LESS 10)
+  message(FATAL_ERROR "${LOG} has ${n} rows: the session was not logged")
+endif()
