@@ -40,6 +40,8 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <tuple>
+#include <utility>
 #include <vector>
 
 #include "rccx/kinematics/kinematics.hpp"
@@ -48,6 +50,11 @@
 #include "rccx/rccl/position.hpp"
 #include "rccx/rccl/trajectory.hpp"
 #include "rccx/rccl/transforms.hpp"
+#include "rccx/rtc/types.hpp"
+
+namespace rccx::bench {
+std::pair<rccl::TransformPtr, rccl::TransformPtr> c_moving_transforms(const math::Vec3& obj);
+}
 
 namespace {
 
@@ -88,7 +95,7 @@ Line line_of(const std::string& robot) {
   return robot == "microbo" ? microbo_line() : puma_line();
 }
 
-enum class Case { joint, cartesian, cartesian_2_functional };
+enum class Case { joint, cartesian, cartesian_2_functional, cartesian_2_c_functional };
 
 /// One robot, its generator and the motion it repeats; steps it sample by sample.
 class Rig {
@@ -117,6 +124,8 @@ class Rig {
       obj_ = rccl::functional("OBJ", [obj](const rccl::SampleContext& ctx) {
         return Transform::translation(obj.x, obj.y, obj.z + kObjectSpeed * ctx.t_s);
       });
+    } else if (c == Case::cartesian_2_c_functional) {
+      std::tie(conv_, obj_) = bench::c_moving_transforms(obj);
     } else {
       conv_ = rccl::constant("CONV", Transform::identity());
       obj_ = rccl::constant("OBJ", Transform::translation(obj));
@@ -188,6 +197,10 @@ class Rig {
   std::uint64_t step() {
     ctx_.t_s = static_cast<double>(k_) * kPeriod;
     ctx_.sample = ++sample_;
+    // The loop's How, as a session gives it (a C transform's function runs only in the loop).
+    how_.time_s = ctx_.t_s;
+    how_.sample = ctx_.sample;
+    ctx_.how = &how_;
     const std::uint64_t id = gen_.step(ctx_, &measured_, q_);
     measured_ = q_;  // an ideal arm: where it was told to be
     ++k_;
@@ -247,6 +260,7 @@ class Rig {
   rccl::MotionSettings settings_;
   JointVector q_start_, q_, measured_;
   rccl::SampleContext ctx_;
+  rtc::How how_;
   std::uint64_t sample_ = 0, last_id_ = 0, id_ = 0;
   std::size_t k_ = 0, begin_ = 0, end_ = 0, wrong_id_ = 0;
   std::uint32_t straight_at_window_ = 0;
@@ -305,6 +319,11 @@ void BM_SetpointCartesian(benchmark::State& state, const std::string& robot) {
 }
 void BM_SetpointCartesian2Functional(benchmark::State& state, const std::string& robot) {
   run_setpoint(state, robot, Case::cartesian_2_functional);
+}
+/// The same sample with CONV and OBJ written in C over compat/rccl.h (bench/compat_bench.cpp):
+/// the price of the C calling convention and of mm in a TRSF.
+void BM_SetpointCartesian2CFunctional(benchmark::State& state, const std::string& robot) {
+  run_setpoint(state, robot, Case::cartesian_2_c_functional);
 }
 
 // ---- the peer: one Cartesian sample with Orocos KDL, PUMA 560 -----------------------------
@@ -454,8 +473,10 @@ void BM_PeerKdlCartesianSample(benchmark::State& state, KdlIk which) {
 BENCHMARK_CAPTURE(BM_SetpointJoint, microbo, std::string("microbo"));
 BENCHMARK_CAPTURE(BM_SetpointCartesian, microbo, std::string("microbo"));
 BENCHMARK_CAPTURE(BM_SetpointCartesian2Functional, microbo, std::string("microbo"));
+BENCHMARK_CAPTURE(BM_SetpointCartesian2CFunctional, microbo, std::string("microbo"));
 BENCHMARK_CAPTURE(BM_SetpointJoint, puma560, std::string("puma560"));
 BENCHMARK_CAPTURE(BM_SetpointCartesian, puma560, std::string("puma560"));
 BENCHMARK_CAPTURE(BM_SetpointCartesian2Functional, puma560, std::string("puma560"));
+BENCHMARK_CAPTURE(BM_SetpointCartesian2CFunctional, puma560, std::string("puma560"));
 BENCHMARK_CAPTURE(BM_PeerKdlCartesianSample, lma, KdlIk::lma);
 BENCHMARK_CAPTURE(BM_PeerKdlCartesianSample, nr_jl, KdlIk::nr_jl);
