@@ -265,3 +265,26 @@ TEST(CellRuntime, WithoutStopOnFaultTheOthersGoOn) {
   EXPECT_EQ(microbo.waitfor(b2.end(), 20s), rccl::WaitResult::reached) << failures_of(microbo);
   EXPECT_TRUE(microbo.failures().empty());
 }
+
+TEST(CellRuntime, TheToolFrameIsTheKinematicsT6OfTheLastSetpoint) {
+  // The cell takes each robot's tool frame from its capsules' link frames (one forward
+  // kinematics a robot a tick): the same as the solver's T6, base and tool applied.
+  const auto c = cell::Cell::load(kCvarl);
+  c->start();
+  rccl::Manipulator& puma = c->robot("puma");
+  rccl::Manipulator& microbo = c->robot("microbo");
+  puma.set_velocity(0.05, 0.5);
+  microbo.set_velocity(0.05, 0.5);
+  puma.move(world_position(*c, "puma", "P1", down_at(kAbove + math::Vec3{-0.05, 0.0, 0.0})));
+  microbo.move(world_position(*c, "microbo", "M1", down_at(kAbove + math::Vec3{0.10, 0.0, 0.0})));
+  c->wait_for(300ms);
+  for (const std::string name : {"puma", "microbo"}) {
+    rccl::Manipulator& m = c->robot(name);
+    const kin::JointVector& q = m.generator().last_setpoint();
+    const math::Transform tool =
+        c->model().robots[c->index(name)].tool.value_or(math::Transform::identity());
+    const math::Transform expected = c->base(name) * m.kinematics().forward(q) * tool;
+    EXPECT_LT(math::max_abs_difference(c->tool_sample(name).pose, expected), 1e-9) << name;
+    EXPECT_DOUBLE_EQ(c->tool_sample(name).t_s, m.generator().last_setpoint_time_s()) << name;
+  }
+}

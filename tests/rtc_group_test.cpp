@@ -316,3 +316,43 @@ TEST(SessionGroup, OneThreadStillEndsACycleThatOverruns) {
   r0.release();
   r1.release();
 }
+
+TEST(SessionGroup, OneThreadInRealTimeTakesALateTickAsNoSpeedViolation) {
+  // One thread in real time: a stall of several periods makes the next tick come late. The
+  // sample's time is its nominal one (a period after the last), so a setpoint planned along
+  // How::time_s steps one period's worth: joint 1 at half its top speed stays within it (a step
+  // over the 5 periods of the stall would be 2.5 times the top speed).
+  Arms a(1);
+  rtc::SessionOptions o;
+  o.clock = rtc::ClockKind::real_time;
+  o.real_time_scheduling = false;  // a test must not take a core from the others
+  o.period = 2ms;
+  o.one_thread = true;
+  rtc::SessionGroup group(o);
+  rtc::Session& s = group.add(*a.drivers[0]);
+  group.start();
+  const double top = kin::builtin_robot("puma560").joints[0].max_velocity;
+  std::atomic<bool> stall{false};
+  double start_range = -1.0, start_t = 0.0;
+  s.control(
+      [&](rtc::Control& c) {
+        const rtc::How& h = c.how();
+        if (start_range < 0.0) {
+          start_range = h.joint[0].range;
+          start_t = h.time_s;
+        }
+        c.chg().posvel(0, start_range + 0.5 * top * (h.time_s - start_t));
+      },
+      [&](rtc::Control& c) {
+        if (stall.exchange(false)) c.spend(9ms);  // busy: the next ticks come late
+      });
+  std::this_thread::sleep_for(40ms);
+  stall = true;
+  std::this_thread::sleep_for(60ms);
+  EXPECT_GE(group.latency().missed_deadlines, 3U);
+  EXPECT_GE(group.latency().late_wakeups, 1U);
+  EXPECT_LE(group.latency().late_wakeups, group.latency().missed_deadlines);
+  EXPECT_FALSE(s.termination().ended())
+      << rtc::to_string(s.termination().code) << ": " << s.termination().detail_view();
+  s.release();
+}

@@ -29,6 +29,7 @@ rtc::SessionOptions group_options(const CellModel& m, const CellOptions& o) {
   so.clock = o.clock;
   so.real_time_scheduling = o.real_time_scheduling;
   so.one_thread = o.one_thread;
+  so.spin_before_tick = o.spin_before_tick;
   return so;
 }
 
@@ -57,6 +58,24 @@ double Cell::braking_m(const kin::RobotModel& model, const kin::JointVector& q0,
     const double travel = v[j] * (Ts / 2.0 + period_s);
     d += model.joints[j].type == kin::JointType::prismatic ? travel : travel * lever_m[j];
   }
+  return d;
+}
+
+// braking_m() on the robot's own copies of its constants, the same arithmetic in the same order
+// (a lever of 1 for a prismatic joint multiplies by one exactly).
+double Cell::braking_fast(const Robot& r, const kin::JointVector& q0,
+                          const kin::JointVector& q1) noexcept {
+  const std::size_t n =
+      std::min({q0.size(), q1.size(), r.max_acceleration.size(), r.travel_factor.size(), r.dof});
+  const double period_s = r.period_s;
+  std::array<double, kin::kMaxJoints> v{};
+  double Ts = 0.0;
+  for (std::size_t j = 0; j < n; ++j) {
+    v[j] = std::abs(q1[j] - q0[j]) / period_s + r.max_acceleration[j] * period_s;
+    Ts = std::max(Ts, v[j] / r.max_acceleration[j]);
+  }
+  double d = 0.0;
+  for (std::size_t j = 0; j < n; ++j) d += v[j] * (Ts / 2.0 + period_s) * r.travel_factor[j];
   return d;
 }
 
@@ -108,8 +127,18 @@ Cell::Cell(CellModel model, CellOptions options)
     ToolSample s;
     s.pose = cr.base * r->manipulator->kinematics().forward(ready) * r->tool;
     r->published.store(s);
+    r->last = s;
     // The largest allowance a robot can need: at its top speeds.
     const rccl::GeneratorOptions& g = r->manipulator->generator().options();
+    r->generator = &r->manipulator->generator();
+    r->dof = cr.model.dof();
+    r->max_acceleration = g.max_acceleration;
+    r->travel_factor = r->lever_m;
+    for (std::size_t j = 0; j < r->travel_factor.size() && j < cr.model.dof(); ++j) {
+      if (cr.model.joints[j].type == kin::JointType::prismatic) r->travel_factor[j] = 1.0;
+    }
+    generators_.push_back(r->generator);
+    sessions_.push_back(r->session);
     kin::JointVector q1 = ready;
     for (std::size_t j = 0; j < q1.size(); ++j) q1[j] += g.max_velocity[j] * r->period_s;
     widest_allowance_m =
@@ -127,6 +156,7 @@ Cell::Cell(CellModel model, CellOptions options)
   last_distance_m_.assign(n * n, kInf);
   seen_.assign(n * n, 0);
   tracked_.reserve(contacts_.size());  // the loop pushes within it: no allocation
+  group_->set_robot_hook([this](std::size_t i, std::uint32_t) { on_robot(i); });
   group_->set_cycle_hook([this](std::uint32_t tick) { on_cycle(tick); });
 }
 
@@ -367,45 +397,64 @@ void Cell::set_cycle_observer(std::function<void(std::uint32_t)> observer) {
   observer_ = std::move(observer);
 }
 
+void Cell::on_robot(std::size_t i) noexcept {
+  Robot& r = *robots_[i];
+  const rccl::TrajectoryGenerator& g = *r.generator;
+  const kin::JointVector& q = g.last_setpoint();
+  if (q.size() != r.dof) return;  // no setpoint yet
+  const double t = g.last_setpoint_time_s();
+  if (r.valid && t == r.last_t_s) return;  // nothing new
+  // The tool frame, for followers (published at the tick's end, so that the robots after this
+  // one in the tick see the last tick's, as they would in any order): from the capsules' link
+  // frames, which the collision world computes from q anyway; velocities from the last two
+  // published samples.
+  ToolSample s;
+  if (world_->set_configuration(i, q)) {
+    s.pose = world_->robot(i).link_frame(r.dof - 1) * r.tool;
+  } else {  // a setpoint that is not finite: the capsules keep the last one
+    s.pose = model_.robots[i].base * r.manipulator->kinematics().forward(q) * r.tool;
+  }
+  s.t_s = t;
+  const ToolSample& before = r.last;
+  const double dt = t - r.last_t_s;
+  if (r.valid && dt > 0.0) {
+    // Differences of the setpoints: the backward difference is the velocity half a period
+    // back; the change of it over the period, the acceleration.
+    const math::Vec3 v_back = (s.pose.p - before.pose.p) * (1.0 / dt);
+    s.acceleration_m_per_s2 = (v_back - r.velocity_back) * (1.0 / dt);
+    s.velocity_m_per_s = v_back + s.acceleration_m_per_s2 * (dt / 2.0);
+    r.velocity_back = v_back;
+    math::Vec3 axis;
+    double angle = 0.0;
+    (s.pose.R * before.pose.R.transposed()).to_axis_angle(axis, angle);
+    s.angular_velocity_rad_s = axis * (angle / dt);
+  }
+  r.next = s;
+  r.fresh = true;
+  r.last_t_s = t;
+  r.braking_m = braking_fast(r, g.previous_setpoint(), q);
+  r.valid = true;
+}
+
 void Cell::on_cycle(std::uint32_t tick) noexcept {
   double braking_max_m = 0.0;  // the largest allowance of this tick
-  for (std::size_t i = 0; i < robots_.size(); ++i) {
+  const std::size_t n = robots_.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    if (i + 2 < n) {  // the next robots' lines this pass reads, ahead of use
+      __builtin_prefetch(robots_[i + 2].get(), 1, 3);
+      __builtin_prefetch(&generators_[i + 2]->ledger(), 0, 3);
+      __builtin_prefetch(sessions_[i + 2], 0, 3);
+    }
     Robot& r = *robots_[i];
-    const rccl::TrajectoryGenerator& g = r.manipulator->generator();
-    r.ledger.copy_from(g.ledger());  // for the gates of the next tick (publish_ledgers)
-    const kin::JointVector& q = g.last_setpoint();
-    if (q.size() != model_.robots[i].model.dof()) continue;  // no setpoint yet
-    const double t = g.last_setpoint_time_s();
-    if (r.valid && t == r.last_t_s) {  // not due this tick: nothing new
+    r.ledger.copy_from(r.generator->ledger());  // for the gates of the next tick
+    if (r.fresh) {
+      r.published.store(r.next);
+      r.last = r.next;
+      r.fresh = false;
+    }
+    if (r.valid && r.generator->last_setpoint().size() == r.dof) {
       braking_max_m = std::max(braking_max_m, r.braking_m);
-      continue;
     }
-    // The tool frame, for followers: velocities from the last two published samples.
-    ToolSample before;
-    r.published.load(before);  // this thread is the only writer: never waits
-    ToolSample s;
-    s.pose = model_.robots[i].base * r.manipulator->kinematics().forward(q) * r.tool;
-    s.t_s = t;
-    const double dt = t - r.last_t_s;
-    if (r.valid && dt > 0.0) {
-      // Differences of the setpoints: the backward difference is the velocity half a period
-      // back; the change of it over the period, the acceleration.
-      const math::Vec3 v_back = (s.pose.p - before.pose.p) * (1.0 / dt);
-      s.acceleration_m_per_s2 = (v_back - r.velocity_back) * (1.0 / dt);
-      s.velocity_m_per_s = v_back + s.acceleration_m_per_s2 * (dt / 2.0);
-      r.velocity_back = v_back;
-      math::Vec3 axis;
-      double angle = 0.0;
-      (s.pose.R * before.pose.R.transposed()).to_axis_angle(axis, angle);
-      s.angular_velocity_rad_s = axis * (angle / dt);
-    }
-    r.published.store(s);
-    r.last_t_s = t;
-    world_->set_configuration(i, q);
-    r.braking_m = braking_m(model_.robots[i].model, g.previous_setpoint(), q,
-                            g.options().max_acceleration, r.period_s, r.lever_m);
-    r.valid = true;
-    braking_max_m = std::max(braking_max_m, r.braking_m);
   }
   if (options_.collision_checks) {
     world_->set_margin(

@@ -66,6 +66,8 @@ struct CellOptions {
   /// Both tasks of the group on one thread (rtc::SessionOptions::one_thread): no hand-overs
   /// between processors, no watchdog for a hung control function. For load tests.
   bool one_thread = false;
+  /// Real time only: rtc::SessionOptions::spin_before_tick.
+  std::chrono::nanoseconds spin_before_tick{0};
 };
 
 /// Motions of several robots that start in the same sample (Cell::together).
@@ -195,10 +197,20 @@ class Cell {
     kin::JointVector lever_m;  ///< levers_m()
     SeqLock<ToolSample> published;
     // Control task only.
+    const rccl::TrajectoryGenerator* generator = nullptr;
+    std::size_t dof = 0;
+    /// braking_m()'s inputs that do not change: the generator's acceleration bounds, and the
+    /// levers with a prismatic joint's 1 m per m, kept here so that the hook does not reach
+    /// into the robot model and the generator's options every tick.
+    kin::JointVector max_acceleration;
+    kin::JointVector travel_factor;
     double last_t_s = -1.0;  ///< the setpoint time last published
     bool valid = false;      ///< has a setpoint in the collision world
+    bool fresh = false;      ///< `next` is this tick's, to be published at the tick's end
     double braking_m = 0.0;
     math::Vec3 velocity_back;   ///< the tool point's last backward difference, m/s
+    ToolSample last;            ///< the last sample published
+    ToolSample next;            ///< this tick's, computed after the robot's f2
     rccl::MotionLedger ledger;  ///< the generator's, as of the end of the last tick
     bool was_controlling = false;
   };
@@ -206,6 +218,11 @@ class Cell {
   [[nodiscard]] const Robot& find(std::string_view name) const;
   [[nodiscard]] Robot& find(std::string_view name);
   void on_cycle(std::uint32_t tick) noexcept;
+  /// Robot i's part of the tick's checks, right after its f2 (SessionGroup's robot hook): its
+  /// capsules, its tool frame (kept for the tick's end) and its braking allowance.
+  void on_robot(std::size_t i) noexcept;
+  [[nodiscard]] static double braking_fast(const Robot& r, const kin::JointVector& q0,
+                                           const kin::JointVector& q1) noexcept;
   void check_collisions() noexcept;
   void publish_ledgers() noexcept;
 
@@ -213,6 +230,10 @@ class Cell {
   CellOptions options_;
   // Declared before the group: the cycle hook uses them until the group's tasks stop.
   std::vector<std::unique_ptr<Robot>> robots_;
+  /// Each robot's generator and session, side by side, so that the tick's last pass can fetch
+  /// the next robots' ahead of use.
+  std::vector<const rccl::TrajectoryGenerator*> generators_;
+  std::vector<const rtc::Session*> sessions_;
   std::unique_ptr<CollisionWorld> world_;
   std::vector<Contact> contacts_;        ///< the check's buffer, one per robot pair
   std::vector<double> last_distance_m_;  ///< per robot pair (a * n + b), the last tick's

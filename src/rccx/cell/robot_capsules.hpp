@@ -44,6 +44,12 @@ class RobotCapsules {
   [[nodiscard]] std::size_t dof() const noexcept { return chain_.dof; }
   /// The joint values of the last successful update.
   [[nodiscard]] const kin::JointVector& configuration() const noexcept { return q_; }
+  /// World <- frame i+1 of the chain at the last successful update (frame dof() - 1 is the
+  /// world's T6): what the cell's tool frame is taken from, so that a robot's forward
+  /// kinematics run once a tick.
+  [[nodiscard]] const math::Transform& link_frame(std::size_t i) const noexcept {
+    return frames_[i];
+  }
 
  private:
   /// Which part of which link a capsule covers.

@@ -19,12 +19,14 @@ void LatencyHistogram::record(std::int64_t late_ns) noexcept {
 
 void LatencyHistogram::record_missed(std::uint64_t ticks) noexcept {
   missed_.fetch_add(ticks, std::memory_order_relaxed);
+  late_.fetch_add(1, std::memory_order_relaxed);
 }
 
 void LatencyHistogram::reset() noexcept {
   for (auto& b : *bins_) b.store(0, std::memory_order_relaxed);
   count_.store(0);
   missed_.store(0);
+  late_.store(0);
   max_ns_.store(0);
 }
 
@@ -32,6 +34,7 @@ LatencyStats LatencyHistogram::stats() const {
   LatencyStats s;
   s.wakeups = count_.load(std::memory_order_relaxed);
   s.missed_deadlines = missed_.load(std::memory_order_relaxed);
+  s.late_wakeups = late_.load(std::memory_order_relaxed);
   s.max_us = static_cast<double>(max_ns_.load(std::memory_order_relaxed)) / 1000.0;
   if (s.wakeups == 0) return s;
   // Percentiles at the upper edge of their bin: never reported better than measured.

@@ -11,8 +11,13 @@
 namespace rccx::rtc {
 
 struct LatencyStats {
-  std::uint64_t wakeups = 0;           ///< ticks measured
-  std::uint64_t missed_deadlines = 0;  ///< ticks skipped because a wake-up came a period late
+  std::uint64_t wakeups = 0;  ///< ticks measured
+  /// Deadlines missed: the ticks skipped because a wake-up came a period or more late (a stall
+  /// of k periods counts k).
+  std::uint64_t missed_deadlines = 0;
+  /// Wake-ups a period or more late (a stall of k periods counts 1): what cyclictest's
+  /// histogram shows as latencies of an interval or more.
+  std::uint64_t late_wakeups = 0;
   double p50_us = 0.0, p99_us = 0.0, p999_us = 0.0, max_us = 0.0;
 };
 
@@ -23,6 +28,7 @@ class LatencyHistogram {
   LatencyHistogram();
   /// Communication task: one wake-up `late_ns` after its deadline.
   void record(std::int64_t late_ns) noexcept;
+  /// A wake-up so late that `ticks` deadlines passed (one late wake-up).
   void record_missed(std::uint64_t ticks) noexcept;
   void reset() noexcept;
   [[nodiscard]] LatencyStats stats() const;
@@ -31,6 +37,7 @@ class LatencyHistogram {
   std::unique_ptr<std::array<std::atomic<std::uint32_t>, kBins>> bins_;
   std::atomic<std::uint64_t> count_{0};
   std::atomic<std::uint64_t> missed_{0};
+  std::atomic<std::uint64_t> late_{0};
   std::atomic<std::int64_t> max_ns_{0};
 };
 

@@ -122,6 +122,7 @@ struct Session::Clock {
 
   std::vector<Session*> sessions;                 ///< fixed once the tasks run
   std::function<void(std::uint32_t)> cycle_hook;  ///< after every f2 of a tick (a group's)
+  std::function<void(std::size_t, std::uint32_t)> robot_hook;  ///< after each robot's f2
   std::thread communication_thread;
   std::thread control_thread;
   bool running = false;
@@ -133,6 +134,7 @@ struct Session::Clock {
 
   // The communication task's own.
   std::uint32_t last_published = 0;  ///< last tick handed to control
+  std::int64_t nominal_ns = 0;       ///< real time: the last sample's time (see wait_tick)
   std::int64_t last_published_tick_ns = 0;
 
   [[nodiscard]] bool simulated() const noexcept { return options.clock == ClockKind::simulated; }
@@ -151,34 +153,18 @@ struct Session::Clock {
   /// watchdog kick.
   void run_f1s(std::uint32_t k) noexcept;
   void finish_cycle(std::uint32_t k) noexcept;
+  /// After every f2 of tick k (`spent_ns` charged by them): the cycle hook, the watchdog kick.
+  void end_cycle(std::uint32_t k, std::int64_t spent_ns) noexcept;
+  /// The robot hook for `s`, guarded.
+  void after_f2(Session* s, std::uint32_t k) noexcept;
+  /// One thread: tick k, robot after robot (see SessionOptions::one_thread).
+  void one_thread_tick(std::uint32_t k, std::int64_t tick_ns, std::int64_t started) noexcept;
   /// The communication task's side after the f1s: every Chg of tick k taken (or, not
   /// `in_time`, control ended with overrun), every How published.
   void take_chgs(std::uint32_t k, bool in_time) noexcept;
   /// A robot of tick k whose control still runs.
   [[nodiscard]] static bool in_cycle(const Session* s, std::uint32_t k) noexcept;
   void step_simulated_sample();
-};
-
-// One robot's side: what the planning level, the communication task and the control task
-// exchange for it.
-struct Session::Shared {
-  std::atomic<std::uint32_t> phase{kIdle};
-  std::atomic<std::uint32_t> generation{0};  ///< bumped by control(): comm resets its state
-  std::atomic<std::uint32_t> pending{0};
-  std::atomic<std::uint32_t> in_cycle{0};  ///< the tick whose control cycle includes this robot
-  std::atomic<bool> user_hangup{false};
-  std::atomic<std::int32_t> requested_code{0};
-  std::atomic<std::int32_t> requested_joint{0};
-  std::atomic<SampleLog*> log{nullptr};
-
-  How how;                  ///< guarded by the clock's how_ready / the next tick
-  Chg chg;                  ///< guarded by the clock's chg_ready / chg_taken
-  Termination termination;  ///< written while kEnding, read once kEnded
-  Control control;          ///< the control task's own
-  mutable detail::Latest<How> latest;
-
-  mutable std::mutex snapshot_mutex;  ///< planning side only
-  mutable How snapshot;
 };
 
 struct Session::CommState {
@@ -192,6 +178,32 @@ struct Session::CommState {
   bool ended = false;
   std::array<double, kMaxJoints> last_target{};
   std::array<bool, kMaxJoints> has_target{};
+};
+
+// One robot's side: what the planning level, the communication task and the control task
+// exchange for it.
+// Hot first: what every tick touches (the flags, the communication task's How and Chg, the
+// control task's), then what the planning level reads.
+struct Session::Shared {
+  std::atomic<std::uint32_t> phase{kIdle};
+  std::atomic<std::uint32_t> generation{0};  ///< bumped by control(): comm resets its state
+  std::atomic<std::uint32_t> pending{0};
+  std::atomic<std::uint32_t> in_cycle{0};  ///< the tick whose control cycle includes this robot
+  std::atomic<bool> user_hangup{false};
+  std::atomic<std::int32_t> requested_code{0};
+  std::atomic<std::int32_t> requested_joint{0};
+  std::atomic<SampleLog*> log{nullptr};
+
+  // Each task's own on lines of their own (with two tasks they run on two processors).
+  alignas(64) CommState comm;   ///< the communication task's own
+  alignas(64) Control control;  ///< the control task's own
+  How how;                      ///< two tasks: guarded by the clock's how_ready / the next tick
+  Chg chg;                      ///< two tasks: guarded by the clock's chg_ready / chg_taken
+  mutable detail::Latest<How> latest;
+  Termination termination;  ///< written while kEnding, read once kEnded
+
+  mutable std::mutex snapshot_mutex;  ///< planning side only
+  mutable How snapshot;
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -239,7 +251,7 @@ void Session::open_channel(const std::string& log_suffix) {
   }
   check_period(period());
   shared_ = std::make_unique<Shared>();
-  comm_ = std::make_unique<CommState>();
+  comm_ = &shared_->comm;
   if (log_suffix.empty()) {
     environment_log_ = SampleLog::from_environment(driver_.model());  // LogError names RCCX_LOG
   } else {
@@ -358,6 +370,7 @@ Session& SessionGroup::add(Driver& driver, int multiple) {
   }
   auto s =
       std::unique_ptr<Session>(new Session(driver, clock_, multiple, "-" + driver.model().name));
+  s->index_ = clock_->sessions.size();
   clock_->sessions.push_back(s.get());
   sessions_.push_back(std::move(s));
   return *sessions_.back();
@@ -366,6 +379,11 @@ Session& SessionGroup::add(Driver& driver, int multiple) {
 void SessionGroup::set_cycle_hook(std::function<void(std::uint32_t tick)> hook) {
   if (clock_->running) throw SessionError("set the cycle hook before start()");
   clock_->cycle_hook = std::move(hook);
+}
+
+void SessionGroup::set_robot_hook(std::function<void(std::size_t, std::uint32_t)> hook) {
+  if (clock_->running) throw SessionError("set the robot hook before start()");
+  clock_->robot_hook = std::move(hook);
 }
 
 void SessionGroup::start() {
@@ -639,25 +657,17 @@ void Session::Clock::communication_task() noexcept {
     tick_started_ns.store(started, std::memory_order_relaxed);
     watchdog(k, tick_ns);
 
+    if (options.one_thread) {
+      one_thread_tick(k, tick_ns, started);
+      comm_done.store(k, std::memory_order_release);
+      ring(planning_bell);
+      continue;
+    }
     bool handed = false;
     for (Session* s : sessions) {
       if (s->communication_cycle(*s->comm_, k, tick_ns)) handed = true;
     }
-    if (handed && options.one_thread) {
-      // The control cycle here, in the order of the two tasks: every f1, every Chg applied,
-      // every f2. Busy before the f1s look at the phases, as control_task() is.
-      handed_tick_ns.store(tick_ns, std::memory_order_relaxed);
-      last_published = k;
-      last_published_tick_ns = tick_ns;
-      control_busy.store(true, std::memory_order_seq_cst);
-      how_ready.store(k, std::memory_order_release);
-      run_f1s(k);
-      chg_ready.store(k, std::memory_order_release);
-      take_chgs(k, true);
-      chg_taken.store(k, std::memory_order_release);
-      finish_cycle(k);
-      control_busy.store(false, std::memory_order_seq_cst);
-    } else if (handed) {
+    if (handed) {
       // Hand How over for every robot at once; wait for the Chg their f1s leave (at most until
       // the next tick).
       handed_tick_ns.store(tick_ns, std::memory_order_relaxed);
@@ -688,6 +698,76 @@ void Session::Clock::communication_task() noexcept {
     comm_done.store(k, std::memory_order_release);
     ring(planning_bell);
   }
+}
+
+namespace {
+// The next robot's first lines, while this one is worked on: the loops over the robots touch
+// each robot's data once a tick, and with hundreds of robots those are rarely in the cache.
+inline void prefetch(const void* p) noexcept {
+  __builtin_prefetch(p, 1, 3);
+}
+}  // namespace
+
+void Session::Clock::one_thread_tick(std::uint32_t k, std::int64_t tick_ns,
+                                     std::int64_t started) noexcept {
+  // Busy before the phases are looked at, as control_task() is: release() waits for it.
+  control_busy.store(true, std::memory_order_seq_cst);
+  handed_tick_ns.store(tick_ns, std::memory_order_relaxed);
+  bool handed = false;
+  std::int64_t spent_ns = 0;
+  const std::size_t n = sessions.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    if (i + 2 < n) prefetch(sessions[i + 2]);  // its shared_, read next time round
+    if (i + 1 < n) {
+      const Shared* next = sessions[i + 1]->shared_.get();
+      prefetch(next);
+      prefetch(&next->comm);
+      prefetch(&next->control);
+    }
+    Session* s = sessions[i];
+    if (!s->communication_cycle(*s->comm_, k, tick_ns)) continue;
+    if (!handed) {
+      handed = true;
+      last_published = k;
+      last_published_tick_ns = tick_ns;
+      how_ready.store(k, std::memory_order_release);
+    }
+    spent_ns += s->run_cycle_in_place(k);
+  }
+  if (handed) {
+    chg_ready.store(k, std::memory_order_release);
+    chg_taken.store(k, std::memory_order_release);
+    end_cycle(k, spent_ns);
+  } else {
+    compute.record(monotonic_ns() - started);  // no control this tick: reading was all
+  }
+  control_busy.store(false, std::memory_order_seq_cst);
+}
+
+std::int64_t Session::run_cycle_in_place(std::uint32_t k) noexcept {
+  // What the two tasks do for this robot (run_f1s, take_chgs, finish_cycle), without the
+  // copies between them: f1 reads the communication task's How, its Chg is taken from the
+  // control task's at once.
+  Shared& s = *shared_;
+  CommState& c = *comm_;
+  std::int64_t spent_ns = 0;
+  if (Clock::in_cycle(this, k)) {
+    Control& ctl = s.control;
+    ctl.how_ = c.how;
+    ctl.period_s_ = std::chrono::duration<double>(period()).count();
+    ctl.spent_ns_ = 0;
+    run_guarded(f1_);
+    if (!c.ended && s.phase.load(std::memory_order_seq_cst) == kControlling) {
+      c.chg = ctl.chg_;
+      apply_taken(c);
+    }
+  }
+  s.latest.publish(c.how);  // with the flags the Chg set
+  if (Clock::in_cycle(this, k)) {
+    spent_ns = run_f2();
+    clock_->after_f2(this, k);
+  }
+  return spent_ns;
 }
 
 void Session::Clock::take_chgs(std::uint32_t k, bool in_time) noexcept {
@@ -723,7 +803,17 @@ bool Session::Clock::wait_tick(std::uint32_t k, std::int64_t& next_deadline,
     return true;
   }
   const std::int64_t deadline = next_deadline;
-  detail::sleep_until(deadline);
+  const std::int64_t spin_ns = options.spin_before_tick.count();
+  if (spin_ns > 0) {
+    detail::sleep_until(deadline - spin_ns);
+    while (monotonic_ns() < deadline) {
+#if defined(__x86_64__) || defined(__i386__)
+      __builtin_ia32_pause();
+#endif
+    }
+  } else {
+    detail::sleep_until(deadline);
+  }
   if (stop.load(std::memory_order_acquire)) return false;
   const std::int64_t period = period_ns.load(std::memory_order_relaxed);
   const std::int64_t late = monotonic_ns() - deadline;
@@ -732,7 +822,12 @@ bool Session::Clock::wait_tick(std::uint32_t k, std::int64_t& next_deadline,
   const std::int64_t missed = late / period;
   if (missed > 0) latency.record_missed(static_cast<std::uint64_t>(missed));
   next_deadline = deadline + (missed + 1) * period;
-  tick_ns = deadline - t0_ns;
+  // The sample's time is its nominal one, a period after the last sample's: the skipped
+  // deadlines are not samples, so a stall delays the motions by its length rather than making
+  // their next setpoints jump over it (which would exceed the joints' top speeds). Without a
+  // stall this is the deadline's own time.
+  nominal_ns += period;
+  tick_ns = nominal_ns;
   return true;
 }
 
@@ -875,16 +970,21 @@ bool Session::controlled_cycle(CommState& c, std::uint32_t k) noexcept {
     }
   }
 
-  // This robot's How for the control task; the clock hands every robot's over at once.
-  s.how = h;
+  // This robot's How for the control task; the clock hands every robot's over at once. (One
+  // thread: f1 reads the communication task's own, run_cycle_in_place.)
+  if (!clock_->options.one_thread) s.how = h;
   s.in_cycle.store(k, std::memory_order_relaxed);
   return true;
 }
 
 void Session::take_chg(CommState& c) noexcept {
+  c.chg = shared_->chg;
+  apply_taken(c);
+}
+
+void Session::apply_taken(CommState& c) noexcept {
   Shared& s = *shared_;
   const How& h = c.how;
-  c.chg = s.chg;
   apply(c, c.chg);
   if (SampleLog* log = s.log.load(std::memory_order_acquire)) {
     LogRow row;
@@ -1052,8 +1152,23 @@ void Session::Clock::control_cycle(std::uint32_t k) noexcept {
 void Session::Clock::finish_cycle(std::uint32_t k) noexcept {
   std::int64_t spent_ns = 0;
   for (Session* s : sessions) {
-    if (in_cycle(s, k)) spent_ns += s->run_f2();
+    if (!in_cycle(s, k)) continue;
+    spent_ns += s->run_f2();
+    after_f2(s, k);
   }
+  end_cycle(k, spent_ns);
+}
+
+void Session::Clock::after_f2(Session* s, std::uint32_t k) noexcept {
+  if (!robot_hook) return;
+  try {
+    robot_hook(s->index_, k);
+  } catch (...) {
+    s->request_termination(TerminateCode::control_exception, 0);
+  }
+}
+
+void Session::Clock::end_cycle(std::uint32_t k, std::int64_t spent_ns) noexcept {
   if (cycle_hook) {
     try {
       cycle_hook(k);

@@ -37,7 +37,10 @@ namespace rccx::rtc {
 
 enum class ClockKind : std::uint8_t {
   simulated,  ///< deterministic; advances only while the program waits in the session
-  real_time,  ///< the monotonic clock
+  /// The monotonic clock. A sample's time (How::time_s) is its nominal one, its number of
+  /// periods since the start: a wake-up a period or more late skips the deadlines it missed
+  /// (counted as missed) but not time, so after a stall the samples' times lag the clock by it.
+  real_time,
 };
 
 /// The sample periods RTC accepts (the thesis ran 28 and 56 ms; modern controllers 1 ms).
@@ -56,11 +59,20 @@ struct SessionOptions {
   std::chrono::milliseconds hang_timeout{std::chrono::seconds(5)};
   /// Real time only: record wake-up latency of the communication task.
   bool measure_latency = true;
-  /// Both tasks on one thread: the communication task runs each tick's control cycle itself
-  /// between handing How over and taking Chg (the same order, f2 after Chg is applied), with
-  /// no hand-over between threads or processors. For loads of many robots on one core; there
-  /// is no watchdog then for a control function that hangs (a cycle longer than the period
-  /// makes the next ticks late, counted as missed), so not for real arms.
+  /// Real time only: the communication task sleeps until this long before each deadline and
+  /// spins the rest (0: sleeps through), so that the wake-up's own latency is hidden when it
+  /// is shorter. Costs that much processor time a period.
+  std::chrono::nanoseconds spin_before_tick{0};
+  /// Both tasks on one thread: the communication task runs each tick's control cycle itself,
+  /// robot after robot: it reads one robot, runs its f1 on the How it read, applies its Chg,
+  /// runs its f2, then goes on to the next robot (each robot's data are touched once a tick,
+  /// while in the cache), and runs the cycle hook after the last. Each robot sees the same
+  /// sequence as with two tasks (f2 after its Chg is applied; the cycle hook after every f2);
+  /// what differs is only the interleaving between robots, which a control function must not
+  /// depend on (it sees no other robot's How or Chg). No hand-over between threads or
+  /// processors. For loads of many robots on one core; there is no watchdog then for a control
+  /// function that hangs (a cycle longer than the period makes the next ticks late, counted as
+  /// missed), so not for real arms.
   bool one_thread = false;
 };
 
@@ -186,11 +198,16 @@ class Session {
   bool communication_cycle(CommState& c, std::uint32_t k, std::int64_t tick_ns) noexcept;
   bool controlled_cycle(CommState& c, std::uint32_t k) noexcept;
   void take_chg(CommState& c) noexcept;
+  /// c.chg into joint commands (and the log).
+  void apply_taken(CommState& c) noexcept;
   void apply(CommState& c, const Chg& chg) noexcept;
   void end_control(CommState& c, TerminateCode code, int joint, std::string_view detail) noexcept;
   void run_guarded(ControlFunction& f) noexcept;
   void run_f1(std::uint32_t k) noexcept;
   std::int64_t run_f2() noexcept;
+  /// One thread: this robot's whole control cycle at tick k in one go (f1 on the communication
+  /// task's How, its Chg applied, f2); the computing f2 charged with spend().
+  std::int64_t run_cycle_in_place(std::uint32_t k) noexcept;
   void request_termination(TerminateCode code, int joint) noexcept;
   void wait_control_idle() const;
   [[nodiscard]] Termination ended_termination() const;
@@ -201,8 +218,9 @@ class Session {
   std::shared_ptr<Clock> clock_;
   int multiple_ = 1;
   bool owns_clock_ = false;
-  std::unique_ptr<Shared> shared_;
-  std::unique_ptr<CommState> comm_;  ///< the communication task's own
+  std::unique_ptr<Shared> shared_;  ///< with the communication task's CommState: one allocation
+  CommState* comm_ = nullptr;       ///< the communication task's own, inside *shared_
+  std::size_t index_ = 0;           ///< in the group (0 alone)
   std::function<void(Session&)> hangup_handler_;
   std::unique_ptr<SampleLog> environment_log_;  ///< RCCX_LOG's, when set
   std::string log_problem_;
@@ -253,6 +271,14 @@ class SessionGroup {
   /// then). Only before start(). Like f1 and f2 it must not block; an exception it throws ends
   /// the control of every robot of the tick with `control_exception`.
   void set_cycle_hook(std::function<void(std::uint32_t tick)> hook);
+  /// A function the control task runs right after each robot's f2, with the robot's index (the
+  /// order of add()) and the tick, while that robot's data are still in the processor's cache:
+  /// per-robot work of the cycle hook (a cell's forward kinematics and capsules). What it
+  /// computes must not be seen by the other robots' control functions before the cycle hook
+  /// (the f2s after it in the tick would otherwise see this tick's values). Only before
+  /// start(); it must not block or throw (an exception ends that robot's control with
+  /// `control_exception`).
+  void set_robot_hook(std::function<void(std::size_t robot, std::uint32_t tick)> hook);
 
  private:
   std::shared_ptr<Session::Clock> clock_;

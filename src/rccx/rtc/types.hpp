@@ -122,7 +122,7 @@ struct JointHow {
 /// The state of the arm, as read by the communication task at the start of a sample.
 struct How {
   std::uint64_t sample = 0;  ///< sample number since the session was opened (first is 1)
-  double time_s = 0.0;       ///< time of this sample, s since the session was opened
+  double time_s = 0.0;       ///< time of this sample, s since the session was opened (nominal)
   std::uint8_t dof = 0;
   std::array<JointHow, kMaxJoints> joint{};
   bool power = false;  ///< arm power on
