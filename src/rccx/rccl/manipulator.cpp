@@ -141,7 +141,7 @@ void Manipulator::set_configuration(std::string_view name) {
   settings_.configuration = c->index;
 }
 
-void Manipulator::check_reachable(const Position& p) const {
+void Manipulator::check_reachable(const Position& p) {
   if (p.in_joints()) {
     const kin::JointVector& q = p.joint_values();
     if (q.size() != kinematics_->dof()) {
@@ -157,19 +157,69 @@ void Manipulator::check_reachable(const Position& p) const {
           "[{:.6g}, {:.6g}]",
           p.name(), out + 1, j.name, q[static_cast<std::size_t>(out)], j.lower, j.upper));
     }
+    planned_configuration();
+    queued_configuration_ = kinematics_->configuration_of(q);
     return;
   }
-  if (p.moves()) return;  // checked by the generator, every sample
+  const auto names = kinematics_->configuration_names();
+  const rtc::How h = session_.how();
+  const SampleContext ctx{h.time_s, h.sample, nullptr};
+  const math::Transform t6 = p.moves() ? p.t6_at(ctx) : p.t6_now();
+  const char* when = p.moves() ? " (its goal as it is now)" : "";
+  if (names.empty()) {
+    const kin::IkResult r = kinematics_->inverse(t6);
+    if (!r) {
+      throw MotionError(fmt::format("position {} cannot be reached{}: {}", p.name(), when,
+                                    kin::describe(r.status)));
+    }
+    return;
+  }
+  const bool asked = settings_.configuration >= 0 && settings_.mode == Mode::joint;
+  const kin::Configuration present = planned_configuration();
+  if (settings_.mode == Mode::cartesian && settings_.configuration >= 0 &&
+      settings_.configuration != present.index) {
+    throw MotionError(fmt::format(
+        "position {}: a Cartesian line keeps the arm's configuration ({}), it cannot change to "
+        "{}: move in joint mode to change configuration",
+        p.name(), kinematics_->configuration_name(present),
+        names[static_cast<std::size_t>(settings_.configuration)]));
+  }
+  const kin::Configuration c =
+      asked ? kin::Configuration{static_cast<std::uint8_t>(settings_.configuration)} : present;
   kin::IkOptions o;
-  if (settings_.configuration >= 0) {
-    o.configuration = kin::Configuration{static_cast<std::uint8_t>(settings_.configuration)};
+  o.configuration = c;
+  const kin::IkResult r = kinematics_->inverse(t6, o);
+  if (r) {
+    queued_configuration_ = c;
+    return;
   }
-  const kin::IkResult r = kinematics_->inverse(p.t6_now(), o);
-  if (!r) {
-    throw MotionError(fmt::format("position {} cannot be reached{}: {}", p.name(),
-                                  o.configuration ? " in the configuration asked for" : "",
-                                  kin::describe(r.status)));
+  std::string others;
+  std::string first;
+  const kin::IkSolutions all = kinematics_->inverse_all(t6);
+  for (const kin::IkResult& s : all.solutions()) {
+    const std::string_view n = kinematics_->configuration_name(s.configuration);
+    others += others.empty() ? "" : ", ";
+    others += n;
+    if (first.empty()) first = n;
   }
+  const std::string_view cname = kinematics_->configuration_name(c);
+  if (others.empty()) {
+    throw MotionError(fmt::format("position {} cannot be reached{} in any configuration: {}",
+                                  p.name(), when, kin::describe(all.status)));
+  }
+  throw MotionError(fmt::format(
+      "position {} cannot be reached{} in configuration {} ({}; {}): {}; it can in {}: "
+      "set_configuration(\"{}\") then move in joint mode",
+      p.name(), when, cname, asked ? "the one asked for" : "the arm's",
+      settings_.mode == Mode::cartesian ? "a Cartesian line keeps it" : "a joint move keeps it",
+      kin::describe(r.status), others, first));
+}
+
+kin::Configuration Manipulator::planned_configuration() {
+  // Nothing queued or moving: the arm's configuration as it stands.
+  if (happened(completed()))
+    queued_configuration_ = kinematics_->configuration_of(session_.how().q());
+  return queued_configuration_;
 }
 
 Motion Manipulator::submit(MotionRequest r, const PositionPtr& keep, const StartWhen& when) {

@@ -87,12 +87,15 @@ class Manipulator {
   [[nodiscard]] const MotionSettings& settings() const noexcept { return settings_; }
 
   // --- Motions ----------------------------------------------------------------------------------
-  /// Queues a motion to `position` and returns at once. A position whose transforms are all
-  /// constant or hold is checked now: throws MotionError (queuing nothing) when no
-  /// configuration reaches it within limits. `when`: the motion starts only once those events
-  /// (other robots' motions, see cell::Cell::event) have happened, or with the others of a
-  /// rendezvous; it then starts from rest (the motion before it comes to rest first unless
-  /// its gates are open by then) and is cancelled with the reason when a gate cannot open.
+  /// Queues a motion to `position` and returns at once. The goal is checked now (a position
+  /// with functional transforms at their present value): throws MotionError (queuing nothing)
+  /// when it cannot be reached within limits in the configuration the motion will use - the
+  /// one asked for with set_configuration() in joint mode, else the one the arm will be in when
+  /// the motion starts (a Cartesian line keeps it) - saying which configurations do reach it.
+  /// `when`: the motion starts only once those events (other robots' motions, see
+  /// cell::Cell::event) have happened, or with the others of a rendezvous; it then starts from rest
+  /// (the motion before it comes to rest first unless its gates are open by then) and is cancelled
+  /// with the reason when a gate cannot open.
   Motion move(const PositionPtr& position, const StartWhen& when = {});
   /// RCCL's stop(): stay where the previous motion ends for `seconds` (gated as move()).
   Motion dwell(double seconds, const StartWhen& when = {});
@@ -146,7 +149,9 @@ class Manipulator {
  private:
   Motion submit(MotionRequest r, const PositionPtr& keep, const StartWhen& when);
   void drain();
-  void check_reachable(const Position& p) const;
+  void check_reachable(const Position& p);
+  /// The configuration the arm will be in once the queued motions have run.
+  kin::Configuration planned_configuration();
 
   rtc::Session& session_;
   std::unique_ptr<kin::Kinematics> kinematics_;
@@ -168,6 +173,9 @@ class Manipulator {
   std::vector<MotionEvent> failures_;
   std::vector<MotionEvent> pending_events_;
   std::set<std::uint64_t> failed_ids_;
+  /// The configuration the queued motions leave the arm in (set by move(); valid while
+  /// motions are queued).
+  kin::Configuration queued_configuration_;
 };
 
 }  // namespace rccx::rccl

@@ -140,7 +140,7 @@ math::Transform Position::product(const Factors& fs, const SampleContext& ctx,
         v = f.value;
         break;
       case TransformKind::functional:
-        v = f.source->evaluate(ctx);
+        v = ctx.predicted ? f.source->value_now(ctx) : f.source->evaluate(ctx);
         break;
       case TransformKind::hold:
         v = holds.values[f.hold_slot];
@@ -215,6 +215,16 @@ math::Transform Position::tool_now() const {
   LatchedHolds holds;
   for (std::uint8_t i = 0; i < hold_count_; ++i) holds.values[i] = holds_[i]->value();
   return product(tool_, {}, holds);
+}
+
+math::Transform Position::t6_at(const SampleContext& ctx) const {
+  LatchedHolds holds;
+  for (std::uint8_t i = 0; i < hold_count_; ++i) holds.values[i] = holds_[i]->value();
+  SampleContext c = ctx;
+  c.predicted = true;  // functional transforms called afresh, the loop's cache left alone
+  math::Transform goal, tool;
+  evaluate(c, holds, goal, tool);
+  return goal * tool.inverse();
 }
 
 math::Transform Position::t6_now() const {

@@ -72,6 +72,9 @@ class Position {
   /// Planning level: T6 for the present values (hold transforms as last set). Only for
   /// positions without functional transforms (otherwise std::logic_error).
   [[nodiscard]] math::Transform t6_now() const;
+  /// Planning level: T6 for the values at `ctx` - functional transforms called afresh with it
+  /// (from the planning thread: their functions must allow that), holds as last set.
+  [[nodiscard]] math::Transform t6_at(const SampleContext& ctx) const;
   /// Planning level: the tool product B1 .. Bj (identity for a position in joints).
   [[nodiscard]] math::Transform tool_now() const;
 

@@ -21,6 +21,27 @@ constexpr double smoothstep(double u) noexcept {
   return u * u * u * (10.0 + u * (-15.0 + 6.0 * u));
 }
 
+/// The correction that makes Lloyd and Hayward's blend of two lines free of overshoot: with it,
+/// (1 - s) qa(t) + s qb(t) + (vb - va) 2 tau w(u) is Paul's quartic when a and b are lines of
+/// velocities va and vb (the velocity then passes monotonically from va to vb, never beyond
+/// either), and it stays exact at both ends (w and its derivatives vanish at u = 0 and 1) for
+/// any va, vb: curved segments keep position, velocity and acceleration continuous. Without it
+/// the blend's velocity overshoots by up to 16 % of the change of velocity (the term s' (qb - qa)).
+constexpr double overshoot_correction(double u) noexcept {
+  u = std::clamp(u, 0.0, 1.0);
+  return u * u * u * (1.0 - 0.5 * u) - smoothstep(u) * (u - 0.5);
+}
+
+/// The context for evaluating goals at time t: the sample's own, or a prediction (functional
+/// transforms called afresh for that time).
+SampleContext at_time(const SampleContext& ctx, double t) noexcept {
+  if (std::abs(t - ctx.t_s) < 1e-12) return ctx;
+  SampleContext c = ctx;
+  c.t_s = t;
+  c.predicted = true;
+  return c;
+}
+
 /// Peak acceleration of a transition per unit change of velocity and unit 1/tau: Paul's quartic
 /// 0.75, the smoothstep blend of two lines 1.875 (its (2u - 1) s(u) has |d2/du2| <= 7.5 at
 /// u = 1/2, and d/dt = d/du / 2 tau).
@@ -31,6 +52,16 @@ constexpr double kSmoothPeak = 1.875;
 constexpr double kAccelerationGuard = 2.0;
 /// A segment is slowed at most this much to fit the transition into it.
 constexpr double kMaxStretch = 8.0;
+/// A transition is sampled and replanned at most this many times.
+constexpr int kPlanningPasses = 6;
+/// A Cartesian segment is sampled at most this many times when it is planned.
+constexpr double kSegmentChecks = 1024.0;
+/// A Cartesian segment is slowed at most this much for its own sake (its joints' speeds and
+/// accelerations along the line); one that would need more is refused as too close to a
+/// singularity.
+constexpr double kMaxSegmentStretch = 50.0;
+/// ... and its first and last this many periods, every period.
+constexpr double kEndChecks = 32.0;
 
 /// The pose a fraction s of the way from a to b: position on the line, rotation about the
 /// fixed axis of a⁻¹ b.
@@ -167,7 +198,7 @@ bool TrajectoryGenerator::solve(const Segment& s, const math::Transform& t6,
 
 bool TrajectoryGenerator::segment_value(const Segment& s, const SampleContext& ctx, double t,
                                         const JointVector& near, JointVector& q, kin::IkStatus& why,
-                                        Pose* pose) const {
+                                        Pose* pose, bool linear_past_ends) const {
   switch (s.kind) {
     case Segment::Kind::rest:
       q = s.q1;
@@ -179,20 +210,22 @@ bool TrajectoryGenerator::segment_value(const Segment& s, const SampleContext& c
       return true;
     }
     case Segment::Kind::cartesian: {
+      const SampleContext c = at_time(ctx, t);
       const double r = drive_fraction(s, t);
       Pose p;
-      pose_at(s, ctx, r, p);
+      pose_at(s, c, r, p);
       if (pose) *pose = p;
-      if (solve(s, p.t6, near, q, why)) return true;
-      if (r >= 0.0 && r <= 1.0) return false;
+      const bool inside = r >= 0.0 && r <= 1.0;
+      if ((inside || !linear_past_ends) && solve(s, p.t6, near, q, why)) return true;
+      if (inside) return false;
       // Past its ends (a transition blends the segments extended beyond them) the line may
       // leave the workspace or a joint's limits although the blend does not: continue it in
       // joint space there, at the rate it has at its end.
       const double r_end = r < 0.0 ? 0.0 : 1.0;
       const double h = r < 0.0 ? 0.01 : -0.01;  // a step back onto the line
       Pose pe, pi;
-      pose_at(s, ctx, r_end, pe);
-      pose_at(s, ctx, r_end + h, pi);
+      pose_at(s, c, r_end, pe);
+      pose_at(s, c, r_end + h, pi);
       JointVector q_end, q_in;
       if (!solve(s, pe.t6, near, q_end, why) || !solve(s, pi.t6, q_end, q_in, why)) return false;
       q = q_end;
@@ -337,6 +370,34 @@ bool TrajectoryGenerator::build(const MotionRequest& r, const SampleContext& ctx
   s.T = s.settings.segment_time_s > 0.0 ? s.settings.segment_time_s : by_speed;
   s.T = std::max(
       {s.T, by_joints, by_acceleration, s.settings.transition_time_s, 2.0 * options_.period_s});
+  if (s.kind == Segment::Kind::cartesian) {
+    // The checks above see the line at 16 points; near a singularity the joints' speed and
+    // acceleration (from the curvature of the path in joint space) peak between them. Sample
+    // the line as it will run and slow it down (a longer T: speed falls as 1 / T, acceleration
+    // as 1 / T^2) until it keeps within the planning fractions of both bounds.
+    const double T0 = s.T;
+    for (int pass = 0;; ++pass) {
+      const Peaks pk = segment_peaks(s, ctx, qB);
+      if (!pk.ok) break;
+      const double k = std::max(pk.speed / kPlanningSpeedFraction,
+                                std::sqrt(pk.acceleration / kPlanningAccelerationFraction));
+      if (!(k > 1.0)) break;
+      // (A moving goal's own motion is not the line's: it cannot be slowed, and the loop's guards
+      // judge it as it comes.)
+      if (s.T >= kMaxSegmentStretch * T0 && !pos.moves()) {
+        // No speed the line may be taken at keeps the joints within their bounds: it runs too
+        // close to a singularity (or the edge of the workspace).
+        fail(r.id, ctx, kin::IkStatus::singular, 0,
+             text("the straight line to {} passes too close to a singularity: even {:.0f} "
+                  "times slower a joint would need {:.1f} times its bound; go round it (another "
+                  "line or a via point) or move in joint mode",
+                  name, s.T / T0, k));
+        return false;
+      }
+      if (pass == 2 * kPlanningPasses || s.T >= kMaxSegmentStretch * T0) break;
+      s.T *= std::min(1.02 * k, kMaxSegmentStretch * T0 / s.T);
+    }
+  }
   s.stop_tau = std::max(options_.period_s, 0.5 * s.settings.transition_time_s);
   for (std::size_t j = 0; j < n; ++j) {
     // The velocity at the end, where the arm stops: a Cartesian line's is not its average.
@@ -349,8 +410,9 @@ bool TrajectoryGenerator::build(const MotionRequest& r, const SampleContext& ctx
   // it, and lengthen it (and the segment, if need be) while a joint would pass its bound.
   const double planned_T = s.T;
   for (int pass = 0; pass < 3; ++pass) {
-    const double worst = blend_acceleration_ratio(s, s, false, blend_between(s, nullptr),
-                                                  s.ts + s.T, s.stop_tau, s.q1, ctx);
+    const double worst =
+        blend_peaks(s, s, false, blend_between(s, nullptr), s.ts + s.T, s.stop_tau, s.q1, ctx)
+            .ratio_or_failed();
     if (!(worst > 1.0)) break;
     // A transition's acceleration falls as 1 / tau; a far larger ratio means a singularity on
     // the way, which lengthening does not cure (the loop will stop the arm there).
@@ -415,6 +477,31 @@ TrajectoryGenerator::Blend TrajectoryGenerator::blend_between(const Segment& a,
 
 double TrajectoryGenerator::transition_tau(const Segment& a, Segment& b, Blend blend, double tB,
                                            const SampleContext& ctx) const {
+  const double T0 = b.T;
+  Peaks pk;
+  double tau = plan_transition(a, b, blend, tB, ctx, pk);
+  b.blend_in = blend;
+  const auto score = [](const Peaks& p) {
+    return p.ok ? std::max(p.speed, p.acceleration) : std::numeric_limits<double>::infinity();
+  };
+  if (blend == Blend::smooth_pose && score(pk) > 1.0) {
+    // The tool's blend cannot be solved (its poses pass a singularity or leave the workspace)
+    // or needs more than the bounds: blend the joints instead, Paul's way.
+    Segment alt = b;
+    alt.T = T0;
+    Peaks pj;
+    const double tau_j = plan_transition(a, alt, Blend::smooth_joint, tB, ctx, pj);
+    if (score(pj) < score(pk)) {
+      b.T = alt.T;
+      b.blend_in = Blend::smooth_joint;
+      tau = tau_j;
+    }
+  }
+  return tau;
+}
+
+double TrajectoryGenerator::plan_transition(const Segment& a, Segment& b, Blend blend, double tB,
+                                            const SampleContext& ctx, Peaks& pk) const {
   const double P = options_.period_s;
   const std::size_t n = kin_.dof();
   const Segment& owner = a.kind == Segment::Kind::rest ? b : a;
@@ -432,8 +519,9 @@ double TrajectoryGenerator::transition_tau(const Segment& a, Segment& b, Blend b
     va[j] = (qa1[j] - qa0[j]) / P;
     vb[j] = (qb1[j] - qb0[j]) / P;
   }
-  const double peak =
-      blend == Blend::smooth_pose || blend == Blend::smooth_joint ? kSmoothPeak : kPaulPeak;
+  // Every blend is Paul's quartic between lines (the smooth ones through their overshoot
+  // correction), whose peak acceleration is 0.75 dv / tau.
+  const double peak = kPaulPeak;
   const auto needed = [&] {
     double t = 0.0;
     for (std::size_t j = 0; j < n; ++j) {
@@ -444,8 +532,10 @@ double TrajectoryGenerator::transition_tau(const Segment& a, Segment& b, Blend b
   // The transition may not reach back past the start of a's straight part: when the change of
   // velocity needs longer than a has left, b (not started yet) is slowed down until it fits -
   // its velocity scales as 1 / T.
-  const double room = a.kind == Segment::Kind::rest ? std::numeric_limits<double>::infinity()
-                                                    : std::max(P, tB - (a.ts + a.tau_in));
+  // (Nor before now: a segment shorter than its transitions is joined late.)
+  const double room = a.kind == Segment::Kind::rest
+                          ? std::numeric_limits<double>::infinity()
+                          : std::max(P, std::min(tB - (a.ts + a.tau_in), tB - ctx.t_s + 1e-9));
   double stretched = 1.0;  // b.T grows by at most kMaxStretch in all
   if (b.kind != Segment::Kind::rest && std::isfinite(room)) {
     double stretch = 1.0;
@@ -472,14 +562,27 @@ double TrajectoryGenerator::transition_tau(const Segment& a, Segment& b, Blend b
   }
   if (b.kind != Segment::Kind::rest) tau = std::min(tau, std::max(P, 0.5 * b.T));
   tau = std::min(tau, room);
-  if (a.kind == Segment::Kind::rest) return tau;
-  // The estimate above is for straight lines in joint space; a Cartesian blend bends them.
-  // Sample the transition as the loop will and lengthen it while a joint would accelerate
-  // past its bound.
-  for (int pass = 0; pass < 3; ++pass) {
-    const double worst = blend_acceleration_ratio(a, b, true, blend, tB, tau, last_q_, ctx);
-    if (!(worst > 1.0) || tau >= room) break;
-    tau = std::min(room, tau * std::min(worst * 1.05, 2.0));
+  pk = Peaks{};
+  // The estimate above is for straight lines in joint space; a Cartesian blend bends them, and
+  // a moving goal adds its own velocity. Sample the transition as the loop will run it: while a
+  // joint would accelerate past its bound, lengthen the transition (and b when it must); while
+  // one would pass its top speed, slow b down (its velocity scales as 1 / T, the transition's
+  // velocity passes between a's and b's).
+  for (int pass = 0;; ++pass) {
+    pk = blend_peaks(a, b, true, blend, tB, tau, last_q_, ctx);
+    if (!pk.ok || pass == kPlanningPasses) break;
+    bool changed = false;
+    if (pk.speed > kTransitionSpeedFraction && stretched < kMaxStretch) {
+      const double stretch =
+          std::min(1.02 * pk.speed / kTransitionSpeedFraction, kMaxStretch / stretched);
+      b.T *= stretch;
+      stretched *= stretch;
+      changed = true;
+    }
+    if (pk.acceleration > 1.0 && tau < room) {
+      tau = std::min(room, tau * std::min(pk.acceleration * 1.05, 2.0));
+      changed = true;
+    }
     if (tau > 0.5 * b.T) {
       const double stretch = std::min(2.0 * tau / b.T, kMaxStretch / stretched);
       if (stretch > 1.0) {
@@ -488,37 +591,86 @@ double TrajectoryGenerator::transition_tau(const Segment& a, Segment& b, Blend b
       }
       tau = std::min(tau, 0.5 * b.T);
     }
+    if (!changed) break;
   }
   return tau;
 }
 
-double TrajectoryGenerator::blend_acceleration_ratio(const Segment& a, const Segment& b,
-                                                     bool to_next, Blend blend, double tB,
-                                                     double tau, const JointVector& near,
-                                                     const SampleContext& ctx) const {
+TrajectoryGenerator::Peaks TrajectoryGenerator::segment_peaks(const Segment& s,
+                                                              const SampleContext& ctx,
+                                                              const JointVector& near) const {
+  // Every period, or T / kSegmentChecks when that is longer (a bounded cost per segment: the
+  // second difference over a longer step still sees a peak, somewhat smoothed); and both ends
+  // every period, where a line that starts or ends near a singularity bends most.
+  Peaks pk;
+  kin::IkStatus why;
+  const auto sweep = [&](double from, double to, double h, const JointVector& seed) {
+    JointVector q0, q1, q2;
+    if (!segment_value(s, ctx, from, seed, q0, why) ||
+        !segment_value(s, ctx, from + h, q0, q1, why)) {
+      return false;
+    }
+    for (double t = from + 2.0 * h; t <= to + 1e-9; t += h) {
+      if (!segment_value(s, ctx, t, q1, q2, why)) return false;
+      for (std::size_t j = 0; j < q1.size(); ++j) {
+        const double acc = std::abs(q2[j] - 2.0 * q1[j] + q0[j]) / (h * h);
+        pk.acceleration = std::max(pk.acceleration, acc / options_.max_acceleration[j]);
+        pk.speed = std::max(pk.speed, std::abs(q2[j] - q1[j]) / h / options_.max_velocity[j]);
+      }
+      q0 = q1;
+      q1 = q2;
+    }
+    return true;
+  };
   const double P = options_.period_s;
+  const double h = std::max(P, s.T / kSegmentChecks);
+  const double end = std::min(s.T, kEndChecks * P);
+  if (!sweep(s.ts, s.ts + s.T, h, near) || !sweep(s.ts, s.ts + end, P, near) ||
+      !sweep(s.ts + s.T - end, s.ts + s.T, P, s.q1)) {
+    return pk;
+  }
+  pk.ok = true;
+  return pk;
+}
+
+TrajectoryGenerator::Peaks TrajectoryGenerator::blend_peaks(const Segment& a, const Segment& b,
+                                                            bool to_next, Blend blend, double tB,
+                                                            double tau, const JointVector& near,
+                                                            const SampleContext& ctx) const {
+  const double P = options_.period_s;
+  Peaks pk;
+  Tangents tg;
+  if (to_next && !tangents(a, b, blend, tB, near, ctx, tg)) return pk;
   JointVector q0, q1, q2;
   kin::IkStatus why;
-  double worst = 0.0;
+  // As the loop will run it: on its sample times (ctx.t_s + k P), the segments' values either
+  // side of the window, so that the joins are judged too.
+  const double eps = 1e-9;
   const auto at = [&](double t, const JointVector& seed, JointVector& q) {
-    return blend_value(a, b, to_next, blend, tB, tau, ctx, t, seed, q, why);
+    if (t < tB - tau - eps) return segment_value(a, ctx, t, seed, q, why);
+    if (t >= tB + tau - eps && to_next) return segment_value(b, ctx, t, seed, q, why);
+    return blend_value(a, b, to_next, blend, tB, tau, tg, ctx, std::min(t, tB + tau), seed, q, why);
   };
-  double t = tB - tau;
-  if (!at(t - P, near, q0) || !at(t, q0, q1)) return -1.0;
-  for (; t <= tB + tau; t += P) {
-    if (!at(t + P, q1, q2)) return -1.0;
+  double t = ctx.t_s + std::floor((tB - tau - ctx.t_s) / P + eps) * P;  // the last before
+  if (!at(t - P, near, q0) || !at(t, q0, q1)) return pk;
+  for (; t <= tB + tau + P; t += P) {
+    if (!at(t + P, q1, q2)) return pk;
     for (std::size_t j = 0; j < q1.size(); ++j) {
       const double acc = std::abs(q2[j] - 2.0 * q1[j] + q0[j]) / (P * P);
-      worst = std::max(worst, acc / options_.max_acceleration[j]);
+      pk.acceleration = std::max(pk.acceleration, acc / options_.max_acceleration[j]);
+      pk.speed = std::max(pk.speed, std::abs(q2[j] - q1[j]) / P / options_.max_velocity[j]);
     }
     q0 = q1;
     q1 = q2;
   }
-  return worst;
+  pk.ok = true;
+  return pk;
 }
 
 void TrajectoryGenerator::begin_transition(const SampleContext& ctx, double tB, double tau,
-                                           Blend blend, bool to_next) noexcept {
+                                           Blend blend, bool to_next) {
+  tr_.tangents = Tangents{};
+  if (to_next) tangents(cur_, next_, blend, tB, last_q_, ctx, tr_.tangents);
   tr_.active = true;
   tr_.tB = tB;
   tr_.tau = tau;
@@ -574,14 +726,51 @@ bool TrajectoryGenerator::value(const SampleContext& ctx, double t, JointVector&
     }
     return ok;
   }
-  return blend_value(cur_, tr_.to_next ? next_ : cur_, tr_.to_next, tr_.blend, tr_.tB, tr_.tau, ctx,
-                     t, last_q_, q, why);
+  return blend_value(cur_, tr_.to_next ? next_ : cur_, tr_.to_next, tr_.blend, tr_.tB, tr_.tau,
+                     tr_.tangents, ctx, t, last_q_, q, why);
+}
+
+bool TrajectoryGenerator::tangents(const Segment& a, const Segment& b, Blend blend, double tB,
+                                   const JointVector& near, const SampleContext& ctx,
+                                   Tangents& out) const {
+  const double P = options_.period_s;
+  if (blend == Blend::smooth_joint) {
+    JointVector qa0, qa1, qb0, qb1;
+    kin::IkStatus why;
+    if (!segment_value(a, ctx, tB - P, near, qa0, why) ||
+        !segment_value(a, ctx, tB, qa0, qa1, why) || !segment_value(b, ctx, tB, qa1, qb0, why) ||
+        !segment_value(b, ctx, tB + P, qb0, qb1, why)) {
+      return false;
+    }
+    out.va = qa0;
+    out.vb = qb0;
+    for (std::size_t j = 0; j < qa0.size(); ++j) {
+      out.va[j] = (qa1[j] - qa0[j]) / P;
+      out.vb[j] = (qb1[j] - qb0[j]) / P;
+    }
+    return true;
+  }
+  if (blend == Blend::smooth_pose) {
+    Pose p0, p1;
+    out.va_p = {};
+    if (a.kind != Segment::Kind::rest) {
+      pose_at(a, at_time(ctx, tB - P), drive_fraction(a, tB - P), p0);
+      pose_at(a, at_time(ctx, tB), drive_fraction(a, tB), p1);
+      out.va_p = (p1.t6.p - p0.t6.p) * (1.0 / P);
+    }
+    pose_at(b, at_time(ctx, tB), drive_fraction(b, tB), p0);
+    pose_at(b, at_time(ctx, tB + P), drive_fraction(b, tB + P), p1);
+    out.vb_p = (p1.t6.p - p0.t6.p) * (1.0 / P);
+  }
+  return true;
 }
 
 bool TrajectoryGenerator::blend_value(const Segment& a, const Segment& b, bool to_next, Blend blend,
-                                      double tB, double tau, const SampleContext& ctx, double t,
-                                      const JointVector& near, JointVector& q,
-                                      kin::IkStatus& why) const {
+                                      double tB, double tau, const Tangents& tg,
+                                      const SampleContext& ctx, double t, const JointVector& near,
+                                      JointVector& q, kin::IkStatus& why) const {
+  const SampleContext c = at_time(ctx, t);
+  const double u = (t - (tB - tau)) / (2.0 * tau);
   switch (blend) {
     case Blend::paul_joint: {
       // Per coordinate, from a's line onto b's (or to rest at the via point).
@@ -602,13 +791,13 @@ bool TrajectoryGenerator::blend_value(const Segment& a, const Segment& b, bool t
     case Blend::paul_r_in: {
       const double r = paul_transition(0.0, 0.0, tau / b.T, tau, tau, t - tB).q;
       Pose p;
-      pose_at(b, ctx, r, p);
+      pose_at(b, c, r, p);
       return solve(b, p.t6, near, q, why);
     }
     case Blend::paul_r_out: {
       const double r = paul_transition(1.0, -tau / a.T, 0.0, tau, tau, t - tB).q;
       Pose p;
-      pose_at(a, ctx, r, p);
+      pose_at(a, c, r, p);
       return solve(a, p.t6, near, q, why);
     }
     case Blend::smooth_pose: {
@@ -616,21 +805,30 @@ bool TrajectoryGenerator::blend_value(const Segment& a, const Segment& b, bool t
       if (a.kind == Segment::Kind::rest) {
         pa.t6 = kin_.forward(a.q1);
       } else {
-        pose_at(a, ctx, drive_fraction(a, t), pa);
+        pose_at(a, c, drive_fraction(a, t), pa);
       }
-      pose_at(b, ctx, drive_fraction(b, t), pb);
-      const double s = smoothstep((t - (tB - tau)) / (2.0 * tau));
+      pose_at(b, c, drive_fraction(b, t), pb);
+      const double s = smoothstep(u);
       const bool on_a = s < 0.5 && a.kind != Segment::Kind::rest;
-      return solve(on_a ? a : b, interpolate(pa.t6, pb.t6, s), near, q, why);
+      math::Transform x = interpolate(pa.t6, pb.t6, s);
+      x.p = x.p + (tg.vb_p - tg.va_p) * (2.0 * tau * overshoot_correction(u));
+      return solve(on_a ? a : b, x, near, q, why);
     }
     case Blend::smooth_joint: {
       JointVector qa, qb;
-      if (!segment_value(a, ctx, t, near, qa, why) || !segment_value(b, ctx, t, near, qb, why)) {
+      // Each segment continued past its ends in joint space, on its tangent there: a Cartesian
+      // line extended as a line may pass a singularity that the blend never comes near.
+      if (!segment_value(a, ctx, t, near, qa, why, nullptr, true) ||
+          !segment_value(b, ctx, t, near, qb, why, nullptr, true)) {
         return false;
       }
-      const double s = smoothstep((t - (tB - tau)) / (2.0 * tau));
+      const double s = smoothstep(u);
+      const double w = 2.0 * tau * overshoot_correction(u);
       q = qa;
-      for (std::size_t j = 0; j < q.size(); ++j) q[j] += s * (qb[j] - qa[j]);
+      const bool corrected = tg.va.size() == q.size() && tg.vb.size() == q.size();
+      for (std::size_t j = 0; j < q.size(); ++j) {
+        q[j] += s * (qb[j] - qa[j]) + (corrected ? (tg.vb[j] - tg.va[j]) * w : 0.0);
+      }
       return true;
     }
   }
@@ -841,8 +1039,7 @@ void TrajectoryGenerator::start_waiting(const SampleContext& ctx, double t) {
     // the start (a goal may move meanwhile).
     const MotionRequest r = *waiting_;
     if (!build(r, ctx, t)) return;  // failed: fail() withdrew it
-    const Blend blend = blend_between(cur_, &next_);
-    const double tau = transition_tau(cur_, next_, blend, t, ctx);
+    const double tau = transition_tau(cur_, next_, blend_between(cur_, &next_), t, ctx);
     has_next_ = false;
     rendezvous_ready_ = true;
     rv->ready(r.slot, now, tau + next_.T + next_.stop_tau, options_.period_s);
@@ -853,15 +1050,14 @@ void TrajectoryGenerator::start_waiting(const SampleContext& ctx, double t) {
   if (!build(r, ctx, t)) return;
   waiting_.reset();
   rendezvous_ready_ = false;
-  const Blend blend = blend_between(cur_, &next_);
-  const double tau = transition_tau(cur_, next_, blend, t, ctx);
+  const double tau = transition_tau(cur_, next_, blend_between(cur_, &next_), t, ctx);
   if (rv != nullptr && rv->end_together()) {
     // Slowed to the slowest: the straight part takes the time left between both transitions
     // (planned for the faster motion, so they stay within the bounds for the slower one).
     next_.T = std::max(next_.T, rv->duration_s() - tau - next_.stop_tau);
   }
   next_.ts = t + tau;
-  begin_transition(ctx, t + tau, tau, blend, true);
+  begin_transition(ctx, t + tau, tau, next_.blend_in, true);
 }
 
 void TrajectoryGenerator::withdraw_from(const MotionRequest& r, const Text& why) noexcept {
@@ -954,14 +1150,13 @@ std::uint64_t TrajectoryGenerator::step(const SampleContext& ctx, const JointVec
         if (build(*waiting_, ctx, te)) {
           joined_ = waiting_;
           waiting_.reset();
-          const Blend blend = blend_between(cur_, &next_);
-          next_tau_ = transition_tau(cur_, next_, blend, te, ctx);
+          next_tau_ = transition_tau(cur_, next_, blend_between(cur_, &next_), te, ctx);
           // Decided late: the window must not have begun already.
           next_tau_ = std::min(next_tau_, te - t);
         }
       }
       if (has_next_ && t >= te - next_tau_ - eps) {
-        begin_transition(ctx, te, next_tau_, blend_between(cur_, &next_), true);
+        begin_transition(ctx, te, next_tau_, next_.blend_in, true);
       } else if (!has_next_ && t >= te - cur_.stop_tau - eps) {
         begin_transition(ctx, te, cur_.stop_tau, blend_between(cur_, nullptr), false);
       }

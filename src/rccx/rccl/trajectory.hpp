@@ -16,14 +16,29 @@
 //   - two Cartesian segments: the blend of Lloyd and Hayward (1993), (1 - s) F1(t) + s F2(t)
 //     with s the quintic smoothstep, of both segments extended past their ends, which stays
 //     continuous when either goal moves; a joint-mode segment next to a Cartesian one: the same
-//     blend of joint vectors.
-// tau is the requested transition time / 2, lengthened so that no joint's acceleration passes
-// its bound.
+//     blend of joint vectors, each segment continued past its ends on its joint-space tangent.
+//     Both carry a correction, (v2 - v1) 2 tau w(u), that makes them Paul's quartic when the
+//     segments are lines: the velocity passes from one segment's to the other's without the
+//     16 % overshoot of the plain blend (which passed a joint's top speed when a fast joint move
+//     followed a Cartesian one). A tool blend that cannot be solved or kept within the bounds
+//     (its poses near a singularity) falls back to the joint blend.
 //
-// A goal that cannot be reached (out of reach, out of limits, a singularity on the way, a
-// joint that would pass its speed limit) is reported as an event: before the motion when it
-// is known then, else when it happens; the arm then stops smoothly where it is (each joint
-// decelerating at its bound, never past a limit) and the queue is cancelled.
+// Slowing down instead of failing (the way Lloyd and Hayward's generator does): nothing is
+// planned from estimates alone. Every transition is sampled as the loop will run it (its sample
+// times, goals predicted at each one - a moving goal's velocity included - and the segments
+// either side), and while a joint would pass its acceleration bound the transition is
+// lengthened (and the next segment with it, when it must), while one would pass
+// kTransitionSpeedFraction of its top speed the next segment is slowed (its velocity scales as
+// 1 / T); the segment now running is never changed, and its room bounds the transition. Every
+// Cartesian segment is sampled along its line (T / 1024, and every period near both ends) and
+// lengthened as a whole until its joints keep within kPlanningSpeedFraction of their top speeds
+// and kPlanningAccelerationFraction of their bounds. The planned setpoints then keep every
+// joint within its top speed and within its acceleration bound times
+// 1 + kAccelerationTolerance. A motion fails only when no slower timing helps: a line through
+// a singularity (a joint would jump), one that leaves the workspace, one that even
+// 50 times slower would pass a bound ("too close to a singularity"); the message
+// says which. The sample loop's guards (top speed, twice the acceleration bound, limits) stay as
+// the last defence and stop the arm smoothly with their own message.
 //
 // The generator owns the two lock-free queues between the planning level and the loop:
 // requests in, events out. Nothing in step() allocates, locks or throws.
@@ -132,6 +147,13 @@ inline constexpr double kPlanningSpeedFraction = 0.9;
 /// Cartesian blend's joint accelerations depend on the kinematics and may exceed the linear
 /// estimate they are planned from by some percent.
 inline constexpr double kPlanningAccelerationFraction = 0.8;
+/// Transitions are checked, sample by sample, against this fraction of the joints' top speeds
+/// (the rest is room for a moving goal's prediction); the next segment is slowed while one
+/// would pass it.
+inline constexpr double kTransitionSpeedFraction = 0.98;
+/// Commanded accelerations (second differences of the setpoints) stay within the bound times
+/// 1 + this: what the sampled check of a transition cannot see between its samples.
+inline constexpr double kAccelerationTolerance = 0.1;
 
 class TrajectoryGenerator {
  public:
@@ -188,6 +210,7 @@ class TrajectoryGenerator {
   void request_stop(std::string_view why) noexcept;
 
  private:
+  enum class Blend : std::uint8_t { paul_joint, paul_r_in, paul_r_out, smooth_pose, smooth_joint };
   struct Segment {
     enum class Kind : std::uint8_t { rest, joint, cartesian };
     Kind kind = Kind::rest;
@@ -205,13 +228,29 @@ class TrajectoryGenerator {
     math::Transform start_in_goal;  ///< cartesian: drive.at(0), the line's start in G's frame
     kin::Configuration configuration;
     bool has_configuration = false;
+    /// The transition into it, as transition_tau chose it (a smooth pose blend that cannot be
+    /// solved or kept within the bounds falls back to the joint blend).
+    Blend blend_in = Blend::paul_joint;
   };
   /// A Cartesian segment's frames at one instant.
   struct Pose {
     math::Transform goal, tool, frame, t6;  ///< G, the tool product, F = G D(r), T6
   };
-  enum class Blend : std::uint8_t { paul_joint, paul_r_in, paul_r_out, smooth_pose, smooth_joint };
+  /// The velocities of a transition's two segments at its via point (rad/s or m/s a joint for
+  /// smooth_joint; T6's origin, m/s, for smooth_pose): what the blends' overshoot correction
+  /// needs. Taken once when the transition is planned and when it begins.
+  struct Tangents {
+    kin::JointVector va, vb;
+    math::Vec3 va_p, vb_p;
+  };
+  /// A transition's peaks as sampled every period, as multiples of the joints' bounds.
+  struct Peaks {
+    bool ok = false;  ///< false: a sample has no solution
+    double speed = 0.0, acceleration = 0.0;
+    [[nodiscard]] double ratio_or_failed() const noexcept { return ok ? acceleration : -1.0; }
+  };
   struct Transition {
+    Tangents tangents;
     bool active = false;
     bool to_next = false;  ///< false: to rest at the end of cur_
     double tB = 0.0, tau = 0.0;
@@ -235,9 +274,11 @@ class TrajectoryGenerator {
   void pose_at(const Segment& s, const SampleContext& ctx, double r, Pose& out) const;
   bool solve(const Segment& s, const math::Transform& t6, const kin::JointVector& near,
              kin::JointVector& q, kin::IkStatus& why) const noexcept;
+  /// `linear_past_ends`: a Cartesian segment continues past its ends in joint space, on its
+  /// tangent there (else on its line, and in joint space only where the line cannot be solved).
   bool segment_value(const Segment& s, const SampleContext& ctx, double t,
                      const kin::JointVector& near, kin::JointVector& q, kin::IkStatus& why,
-                     Pose* pose = nullptr) const;
+                     Pose* pose = nullptr, bool linear_past_ends = false) const;
   [[nodiscard]] Segment rest_of(const Segment& a) const noexcept;
 
   bool build(const MotionRequest& r, const SampleContext& ctx, double t_via);
@@ -256,21 +297,30 @@ class TrajectoryGenerator {
   [[nodiscard]] Blend blend_between(const Segment& a, const Segment* b) const noexcept;
   /// Half the transition from a into b at via time tB, from the change of joint velocity and
   /// the acceleration bound; lengthens b (not started yet) when a has too little room left.
+  /// Sets b.blend_in to the blend chosen.
   double transition_tau(const Segment& a, Segment& b, Blend blend, double tB,
                         const SampleContext& ctx) const;
-  /// The largest joint acceleration of the transition from a into b, sampled every period,
-  /// as a multiple of the joint's bound.
-  /// `near`: joint values close to the transition's start, to seed the inverse kinematics.
-  /// Negative when a sample of the transition has no solution.
-  double blend_acceleration_ratio(const Segment& a, const Segment& b, bool to_next, Blend blend,
-                                  double tB, double tau, const kin::JointVector& near,
-                                  const SampleContext& ctx) const;
+  /// transition_tau for one blend; `peaks`: the transition's as planned.
+  double plan_transition(const Segment& a, Segment& b, Blend blend, double tB,
+                         const SampleContext& ctx, Peaks& peaks) const;
+  /// The largest joint speed and acceleration of the transition from a into b, sampled every
+  /// period as the loop will run it (goals predicted at each sample's time), as multiples of the
+  /// joints' bounds. `near`: joint values close to the transition's start, to seed the inverse
+  /// kinematics.
+  Peaks blend_peaks(const Segment& a, const Segment& b, bool to_next, Blend blend, double tB,
+                    double tau, const kin::JointVector& near, const SampleContext& ctx) const;
+  /// The same for segment s's straight part (ts .. ts + T), seeded with `near` at its start.
+  Peaks segment_peaks(const Segment& s, const SampleContext& ctx,
+                      const kin::JointVector& near) const;
+  /// The velocities of a and b at the via point tB, for the smooth blends; false when a value
+  /// has no solution.
+  bool tangents(const Segment& a, const Segment& b, Blend blend, double tB,
+                const kin::JointVector& near, const SampleContext& ctx, Tangents& out) const;
   /// The transition's setpoint at time t (its window: tB - tau .. tB + tau).
   bool blend_value(const Segment& a, const Segment& b, bool to_next, Blend blend, double tB,
-                   double tau, const SampleContext& ctx, double t, const kin::JointVector& near,
-                   kin::JointVector& q, kin::IkStatus& why) const;
-  void begin_transition(const SampleContext& ctx, double tB, double tau, Blend blend,
-                        bool to_next) noexcept;
+                   double tau, const Tangents& tangents, const SampleContext& ctx, double t,
+                   const kin::JointVector& near, kin::JointVector& q, kin::IkStatus& why) const;
+  void begin_transition(const SampleContext& ctx, double tB, double tau, Blend blend, bool to_next);
   void finish_transition(const SampleContext& ctx);
   bool value(const SampleContext& ctx, double t, kin::JointVector& q, kin::IkStatus& why);
 

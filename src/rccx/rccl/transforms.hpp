@@ -38,6 +38,10 @@ struct SampleContext {
   double t_s = 0.0;               ///< the time the setpoint is for, s since the session opened
   std::uint64_t sample = 0;       ///< the sample it is computed in
   const rtc::How* how = nullptr;  ///< the arm as read this sample (nullptr outside a session)
+  /// True when the trajectory generator asks for the value at another time than the sample's
+  /// (t_s ahead of or behind it, to plan a transition with a moving goal's velocity): the
+  /// function is called afresh (not cached for the sample), with `how` still this sample's.
+  bool predicted = false;
 };
 
 /// A functional transform's function: its value at that sample (m, rad). Runs in the sample
