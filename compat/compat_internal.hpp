@@ -63,6 +63,10 @@ struct TrsfBox {
   /// RCCL_SYSTEM: rccx's transform the live one copies into c at each sample.
   rc::TransformPtr source;
   math::Transform last_good;  ///< functional: the last value that was finite (loop side)
+  /// functional: when last_good was computed, and the position and time of the value before
+  /// (a moving goal's velocity for the generator's predictions).
+  double last_t_s = -1.0, previous_t_s = -1.0;
+  math::Vec3 previous_p;
 };
 
 /// A position the C program holds: the POS it sees and the equation behind it.

@@ -42,7 +42,18 @@ void measured_t6_in_loop(const rc::SampleContext& ctx) noexcept {
 
 /// A functional's value: the struct after its function ran this sample; the last finite value
 /// when the function left something that is not a number (what the arm should not follow).
+/// Asked for another time than the sample's (the generator planning a transition onto a moving
+/// goal): the function is not called - it may count samples, not time - and the position is
+/// extrapolated from the last two samples' values (the goal's velocity, estimated).
 math::Transform functional_value(TrsfBox& b, const rc::SampleContext& ctx) {
+  if (ctx.predicted) {
+    math::Transform v = b.last_good;
+    const double dt = b.last_t_s - b.previous_t_s;
+    if (b.previous_t_s < b.last_t_s && dt < 1.0) {
+      v.p += (b.last_good.p - b.previous_p) * ((ctx.t_s - b.last_t_s) / dt);
+    }
+    return v;
+  }
   if (ctx.how != nullptr) {  // in the sample loop (the planning level reads the value as it is)
     note_sample(ctx);
     measured_t6_in_loop(ctx);
@@ -54,6 +65,11 @@ math::Transform functional_value(TrsfBox& b, const rc::SampleContext& ctx) {
   const auto& R = v.R;
   if (finite(
           {R.n.x, R.n.y, R.n.z, R.o.x, R.o.y, R.o.z, R.a.x, R.a.y, R.a.z, v.p.x, v.p.y, v.p.z})) {
+    if (ctx.how != nullptr && ctx.t_s > b.last_t_s) {
+      b.previous_p = b.last_good.p;
+      b.previous_t_s = b.last_t_s;
+      b.last_t_s = ctx.t_s;
+    }
     b.last_good = v;
   }
   return b.last_good;
@@ -79,7 +95,7 @@ TRSF_PTR make_trsf(std::string name, int type, RCCL_FN fn, const math::Transform
   TrsfBox* b = box.get();
   if (type == RCCL_VARB) {
     box->live = rc::functional(box->name, [b](const rc::SampleContext& ctx) {
-      if (ctx.how != nullptr) note_sample(ctx);
+      if (ctx.how != nullptr && !ctx.predicted) note_sample(ctx);
       return to_math(b->c);
     });
   } else if (type == RCCL_FUNCT) {
@@ -187,9 +203,9 @@ TRSF_PTR keep_transform(const rc::TransformPtr& source) {
   box->source = source;
   TrsfBox* b = box.get();
   box->live = rc::functional(box->name, [b](const rc::SampleContext& ctx) {
-    const math::Transform v =
-        ctx.how != nullptr ? b->source->evaluate(ctx) : b->source->value_now(ctx);
-    if (ctx.how != nullptr) to_c(v, b->c);
+    const bool in_loop = ctx.how != nullptr && !ctx.predicted;  // predictions are not cached
+    const math::Transform v = in_loop ? b->source->evaluate(ctx) : b->source->value_now(ctx);
+    if (in_loop) to_c(v, b->c);
     return v;
   });
   to_c(math::Transform::identity(), box->c);

@@ -28,7 +28,7 @@ TRSF_PTR t;
 int main()
 {
   TRSF_PTR belt, conv, part, tool;
-  POS_PTR ride;
+  POS_PTR ride, wait;
   TRSF now, goal;
   VECT d;
   double worst = 0.;
@@ -39,7 +39,8 @@ int main()
   part = gentr_trsl("PART", 0., 0., 0.);
   tool = gentr_trsl("TOOL", 0., 0., 30.);
   ride = makeposition("RIDE", t6, tool, EQ, belt, conv, part, TL, tool);
-  if (ride == NULL) return 1;
+  wait = makeposition("WAIT", t6, tool, EQ, belt, gentr_trsl("UP", 0., 0., -30.), TL, tool);
+  if (ride == NULL || wait == NULL) return 1;
 
   if (rccl_open(0, 0) || rccl_control()) {
     print_rtc_error(rtc_error, 0);
@@ -47,7 +48,8 @@ int main()
   }
   setvel(150, 90);
   move(park);
-  waitfor(park->end);
+  move(wait);         /* in joint mode: over the belt's start */
+  waitfor(wait->end);
   setmod('c');
   settime(100., 0.);  /* a 0.1 s transition onto the moving part */
   distance("dz", -30.);
@@ -56,7 +58,8 @@ int main()
   waitfor(ride->end);
   until = rtime + 2000;
   while (rtime < until) { /* ride along with it */
-    trmult(&goal, belt, conv);
+    Trsl(&goal, 0., SPEED * (double)(rtime - belt_start) / 1000., 0.); /* the belt now */
+    trmult(&goal, belt, &goal);
     trmult(&goal, &goal, part);
     trmult(&now, t6, tool);
     vecsub(&d, &now.p, &goal.p);
@@ -65,10 +68,8 @@ int main()
   }
   printf("rode %.0f mm along the belt at %.0f mm/s; the tool was within %.2f mm of the part\n",
          conv->p.y, SPEED, worst);
-  distance("dz", -40.);
-  move(ride); /* up, still following */
   setmod('j');
-  move(park);
+  move(park); /* off the belt, a transition out of the tracking */
   waitfor(completed);
   if (rccl_close(0)) {
     print_rtc_error(rtc_error, 0);

@@ -248,12 +248,13 @@ bool TrajectoryGenerator::build(const MotionRequest& r, const SampleContext& ctx
   s.ts = t_via;
   kin::IkStatus why = kin::IkStatus::ok;
 
-  // Where the arm will be at the via point: the present segment's end.
+  // Where the arm will be at the via point: the present segment's end, its goal where it will
+  // be then (a moving goal has moved on by the via time).
   JointVector qB = last_q_;
   math::Transform t6B;
   if (cur_.kind == Segment::Kind::cartesian) {
     Pose p;
-    pose_at(cur_, ctx, 1.0, p);
+    pose_at(cur_, at_time(ctx, t_via), 1.0, p);
     t6B = p.t6;
     if (!solve(cur_, t6B, last_q_, qB, why)) qB = last_q_;
   } else {
