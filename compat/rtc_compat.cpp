@@ -37,6 +37,7 @@
 // clang-format off
 #include "compat_internal.hpp"
 #include "compat_shared.hpp"
+#include "rtc_internal.hpp"
 // clang-format on
 
 namespace rccx::compat {
@@ -280,11 +281,18 @@ int rtc_fail(int code, std::string_view text, bool print = true) noexcept {
   return code;
 }
 
-/// Runs `body`; an exception becomes an error code.
-/// Runs `body`; an exception becomes an error code (`invalid`: for std::invalid_argument).
+/// Runs `body`; an exception becomes an error code (`invalid`: for std::invalid_argument),
+/// said on stderr as the body's own refusals are.
 template <class F>
 int rtc_guarded(const char* call, F&& body, int invalid = RTC_E_INTERNAL) noexcept {
-  return guarded(call, Say::print, invalid, std::forward<F>(body));
+  bool returned = false;
+  const int rc = guarded(call, Say::quiet, invalid, [&] {
+    const int r = body();
+    returned = true;
+    return r;
+  });
+  if (!returned) std::fprintf(stderr, "rtc: %s\n", rtc_error_message());
+  return rc;
 }
 
 rtc::ClockKind clock_from_environment() {
@@ -419,6 +427,11 @@ bool rtc_session_open() noexcept {
   return g_open.load();
 }
 
+rtc::Session* rtc_session() noexcept {
+  Rtc& s = rtc_state();
+  return s.robot ? s.robot->session.get() : nullptr;
+}
+
 }  // namespace rccx::compat
 
 using namespace rccx::compat;
@@ -540,7 +553,7 @@ long rtc_wait_terminated(double timeout_ms) {
     }
     Rtc& s = rtc_state();
     if (!s.controlled) {
-      if (s.last.ended()) {  // ended and released: say how
+      if (s.robot && s.last.ended()) {  // ended and released: say how
         result = static_cast<long>(s.last.code);
         return RTC_OK;
       }
