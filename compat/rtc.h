@@ -83,6 +83,12 @@ const char* rtc_error_name(int code);
  * each refuses with RTC_E_SEQUENCE. No call aborts: a failure returns its code, sets
  * rtc_error and keeps the message (rtc_error_message(), print_rtc_error()).
  *
+ * Old programs: compile with -Werror=implicit-function-declaration (a misspelt or undeclared
+ * call is then an error, not a silent int function), and K&R control functions with implicit
+ * int and no return value with -std=gnu89 -Wno-implicit-int -Wno-return-type
+ * (examples/c/rtc_sine.c). This header compiles without warnings under gnu89, c99 and c11
+ * with -Wall -Wextra -pedantic.
+ *
  * C++ programs: the global variables below are declared only when RCCX_RTC_GLOBALS is defined
  * before this header (rccx's own files keep their local names such as `how`).
  */

@@ -539,6 +539,7 @@ int rtc_wait(double ms) {
     }
     if (!s.controlled) return RTC_OK;
     if (!t.ended()) return RTC_OK;
+    s.stop_watcher();  // its store is over before the program reads terminate
     publish_end(t.code);
     s.last = t;
     return rtc_fail(RTC_E_TERMINATED, fmt::format("rtc_wait: {}", describe_end(t)), false);
@@ -570,6 +571,7 @@ long rtc_wait_terminated(double timeout_ms) {
       t = session.wait_terminated(std::chrono::nanoseconds(std::llround(timeout_ms * 1e6)));
     }
     if (t.ended()) {
+      s.stop_watcher();  // its store is over before the program reads terminate
       publish_end(t.code);
       s.last = t;
     }

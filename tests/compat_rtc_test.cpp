@@ -259,6 +259,7 @@ int count_hangup() {
 }
 
 TEST_F(CompatRtc, CtrlCRunsUserHangupInsteadOfEndingControl) {
+  hangups.store(0);
   user_hangup = count_hangup;
   ASSERT_EQ(control(fn(ramp_fn1), nullptr), RTC_OK);
   std::raise(SIGINT);
@@ -305,8 +306,20 @@ TEST_F(CompatRtc, RealTimeRtcWaitSleepsWhileControlRuns) {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   EXPECT_GE(waited, 0.29);
   EXPECT_EQ(release(nullptr), RTC_OK);
-  EXPECT_GE(fn1_samples, 8);  // 28 ms samples, about 10 in 0.3 s
+  EXPECT_GE(fn1_samples, 5);  // 28 ms samples: about 10 in 0.3 s, fewer on a loaded machine
   EXPECT_LE(fn1_samples, 14);
+}
+
+TEST_F(CompatRtc, RealTimeTerminateSetInFn2IsKeptAndSeenAfterTheWait) {
+  setenv("RCCX_CLOCK", "real", 1);
+  ramp_target = 1.0;
+  ramp_step = 0.001;
+  stop_after = 10;
+  ASSERT_EQ(control(fn(ramp_fn1), fn(ramp_fn2)), RTC_OK);
+  EXPECT_EQ(rtc_wait_terminated(5000.), RTC_TERM_USER_REQUEST);
+  EXPECT_EQ(terminate, 1);
+  EXPECT_EQ(ramp_samples, 10);
+  EXPECT_EQ(release(nullptr), RTC_OK);
 }
 
 }  // namespace
