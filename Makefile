@@ -54,7 +54,7 @@ fuzz: deps
 # The threaded parts (RTC sessions) under ThreadSanitizer.
 tsan: deps
 	$(CMAKE) -S . -B $(TSAN_DIR) -DCMAKE_BUILD_TYPE=Debug -DRCCX_TSAN=ON -DRCCX_BUILD_BENCHMARKS=OFF
-	$(CMAKE) --build $(TSAN_DIR) -j$(JOBS) --target rccx_rtc_tests rccx_cell_runtime_tests
+	$(CMAKE) --build $(TSAN_DIR) -j$(JOBS) --target rccx_rtc_tests rccx_cell_runtime_tests rccx_compat_rtc_tests
 	cd $(TSAN_DIR) && TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1" \
 	  ctest -L rtc --output-on-failure -j$(JOBS)
 
