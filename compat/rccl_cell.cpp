@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "compat_internal.hpp"
+#include "compat_shared.hpp"
 
 namespace rccx::compat {
 
@@ -116,6 +117,12 @@ int rccl_cell_open(const char* cell_file) {
       return fail(RTC_E_SEQUENCE,
                   "rccl_cell_open: a session or cell is open; rccl_close() or rcclRelease() it "
                   "first",
+                  Say::quiet);
+    }
+    if (rtc_session_open()) {
+      return fail(RTC_E_SEQUENCE,
+                  "rccl_cell_open: an RTC session (control, rtc_open) is open; release() or "
+                  "rtc_close() it first",
                   Say::quiet);
     }
     std::string path = cell_file != nullptr ? cell_file : "";

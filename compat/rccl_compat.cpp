@@ -21,6 +21,7 @@
 #include <utility>
 
 #include "compat_internal.hpp"
+#include "compat_shared.hpp"
 #include "rccx/rccl/position_db.hpp"
 #include "rccx/rccl/teach.hpp"
 
@@ -327,6 +328,11 @@ std::string describe_end(const rtc::Termination& t) {
   return out;
 }
 
+bool rccl_session_open() noexcept {
+  const State& s = state();
+  return s.robot != nullptr || s.cell != nullptr;
+}
+
 void take_nextmove() noexcept {
   State& s = state();
   if (loop_saw_nextmove.exchange(false) || nextmove != 0) {
@@ -514,6 +520,12 @@ int rccl_open(const char* robot, double period_ms) {
     }
     if (s.cell) {
       return fail(RTC_E_SEQUENCE, "rccl_open: a cell is open; rcclRelease() it first", Say::quiet);
+    }
+    if (rtc_session_open()) {
+      return fail(RTC_E_SEQUENCE,
+                  "rccl_open: an RTC session (control, rtc_open) is open; release() or "
+                  "rtc_close() it first",
+                  Say::quiet);
     }
     if (!(period_ms >= 0.0) || !std::isfinite(period_ms)) {
       return fail(RTC_E_ARGUMENT,

@@ -213,12 +213,9 @@ TEST_F(CompatRtc, CallsOutOfOrderAreRefused) {
 TEST_F(CompatRtc, AnRtcAndAnRcclSessionAreNotOpenTogether) {
   ASSERT_EQ(rtc_open(), RTC_OK);
   EXPECT_TRUE(rccx::compat::rtc_session_open());
-  const int rc = rccl_open(nullptr, 0.0);
-  if (rc == RTC_OK) {
-    rccl_close(0);
-    GTEST_SKIP() << "rccl_open() does not ask rtc_session_open() yet (wired when merged)";
-  }
-  EXPECT_EQ(rc, RTC_E_SEQUENCE);
+  EXPECT_EQ(rccl_open(nullptr, 0.0), RTC_E_SEQUENCE);
+  EXPECT_NE(std::string(rtc_error_message()).find("RTC session"), std::string::npos);
+  EXPECT_EQ(rccl_cell_open(nullptr), RTC_E_SEQUENCE);
   EXPECT_EQ(rtc_close(0), RTC_OK);
   EXPECT_FALSE(rccx::compat::rtc_session_open());
 

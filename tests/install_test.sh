@@ -36,4 +36,12 @@ cc -std=c11 -o "$work/washer" "$source/examples/washer.c" $flags \
 out=$(RCCX_ROBOT=microbo "$work/washer")
 echo "$out" | tail -3
 grep -q "velocity 110, 120" <<< "$out"
+# A program in the manual's style (K&R functions, a functionally defined monitor, nextmove), as
+# gnu89 with implicit declarations refused, its log written where RCCX_LOG says.
+# shellcheck disable=SC2046,SC2086
+cc -std=gnu89 -Werror=implicit-function-declaration -o "$work/guarded" \
+  "$source/examples/c/guarded.c" $flags $(pkg-config --cflags --libs rccx-compat)
+out=$(RCCX_LOG="$work/guarded.csv" "$work/guarded")
+echo "$out" | tail -1
+grep -q "touched at z = " <<< "$out" && test "$(wc -l < "$work/guarded.csv")" -gt 10
 echo "install_test: the CMake package and rccx-compat.pc build and run programs from outside"

@@ -257,3 +257,52 @@ TEST(RcclConfiguration, GoalOutsideThePresentConfigurationIsRefusedAtTheCall) {
 }
 
 }  // namespace
+
+// The conveyor: a part on a belt at 0.5 m/s, joined in Cartesian mode with a 0.1 s
+// transition (lengthened by the generator as the bounds need) and tracked: the measured tool
+// point (forward kinematics of the joints as read) against the part where the belt has it at
+// the time of that reading, once the arm has joined it.
+TEST(RcclGeneratorRobust, AConveyorAtHalfAMetreASecondIsJoinedAndTrackedWithin2mm) {
+  rtc::SimulatedRobot robot(kin::builtin_robot("puma560"));
+  rccl::Manipulator arm(*robot.session);
+  const kin::Kinematics& kin = arm.kinematics();
+  arm.start();
+  constexpr double kSpeed = 0.5;  // m/s along y
+  // Along y in front of the arm, tool down: configuration ruf reaches all of it (rccx kin ik).
+  const math::Transform start{math::Rot3::rot_x(180_deg), {0.45, -0.2, 0.0}};
+  double t_belt0 = -1.0;  // the belt starts when the arm leaves rest
+  const auto belt_at = [&](double t) {
+    const double dt = t_belt0 < 0.0 ? 0.0 : std::max(0.0, t - t_belt0);
+    return math::Transform::translation(0.0, kSpeed * dt, 0.0);
+  };
+  const auto conv =
+      rccl::functional("CONV", [&](const rccl::SampleContext& ctx) { return belt_at(ctx.t_s); });
+  const auto t6 = rccl::t6();
+  const auto part = rccl::Position::make("PART", {t6}, {conv, rccl::constant("START", start)}, t6);
+  arm.set_configuration("ruf");
+  ASSERT_EQ(arm.waitfor(arm.move(pose_position("OVER", start)).end()), rccl::WaitResult::reached);
+  arm.set_configuration("");
+  robot.session->wait_for(300ms);
+  arm.set_mode(Mode::cartesian);
+  arm.set_transition_time(0.1);
+  arm.set_velocity(1.0, 2.0);
+  t_belt0 = robot.session->how().time_s;
+  const rccl::Motion m = arm.move(part);
+  ASSERT_EQ(arm.waitfor(m.end(), 5s), rccl::WaitResult::reached)
+      << (arm.failures().empty() ? "" : arm.failures().back().message());
+  const double joined_s = robot.session->how().time_s - t_belt0;
+  double worst = 0.0;
+  int samples = 0;
+  for (; samples < 40; ++samples) {  // 0.4 s of tracking, 0.2 m of belt
+    robot.session->wait_for(10ms);
+    const rtc::How h = robot.session->how();
+    const math::Vec3 goal = (belt_at(h.time_s) * start).p;
+    worst = std::max(worst, (kin.forward(h.q()).p - goal).norm());
+  }
+  std::printf("joined the belt %.3f s after it started; tracked within %.2f mm over %d samples\n",
+              joined_s, worst * 1e3, samples);
+  EXPECT_LT(worst, 2e-3);
+  EXPECT_TRUE(arm.failures().empty())
+      << (arm.failures().empty() ? "" : arm.failures().front().message());
+  arm.halt();
+}

@@ -177,7 +177,8 @@ void TrajectoryGenerator::pose_at(const Segment& s, const SampleContext& ctx, do
   } else {
     s.position->evaluate(ctx, s.holds, out.goal, out.tool);
   }
-  out.frame = out.goal * s.drive.at(r);
+  out.frame = s.fixed_start ? math::DriveTransform(s.start_world, out.goal).at(r)
+                            : out.goal * s.drive.at(r);
   out.t6 = out.frame * out.tool.inverse();
 }
 
@@ -337,6 +338,8 @@ bool TrajectoryGenerator::build(const MotionRequest& r, const SampleContext& ctx
     s.kind = Segment::Kind::cartesian;
     s.drive = math::DriveTransform(offset, math::Transform::identity());
     s.start_in_goal = s.drive.at(0.0);
+    s.fixed_start = cur_.kind == Segment::Kind::rest && pos.moves();
+    s.start_world = frameB;
     // Walk the line before moving: a point out of reach or out of limits, or a joint that would
     // need more than its speed, is reported now rather than in the middle of the motion.
     constexpr int kChecks = 16;
@@ -1221,7 +1224,8 @@ void TrajectoryGenerator::record(const SampleContext& ctx, const JointVector& q,
   if (rep.id != cur_.id || !pose_valid_) return;
   const double P = options_.period_s;
   // The line as it stands for the present goal: from the start to the goal, in base frame.
-  const math::Vec3 from = (pose_.goal * cur_.start_in_goal).p;
+  const math::Vec3 from =
+      cur_.fixed_start ? cur_.start_world.p : (pose_.goal * cur_.start_in_goal).p;
   const math::Vec3 to = pose_.goal.p;
   ++rep.straight_samples;
   rep.max_commanded_path_error_m =

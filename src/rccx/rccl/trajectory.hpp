@@ -5,7 +5,10 @@
 // Cartesian mode (the tool frame F = T6 TOOL moves on a straight line, F(t) = G(t) D(r): G the
 // goal, re-evaluated every sample so that a moving goal is tracked, D(r) Paul's drive transform
 // from the start, expressed in the goal's frame, to the goal; the inverse kinematics solved
-// every sample in the configuration the segment started in).
+// every sample in the configuration the segment started in). A Cartesian segment from rest
+// onto a moving goal runs instead from where the arm stands (fixed) to the goal where it is at
+// each sample, F(t) = S D_t(r): a start riding on the goal would have to move at the goal's
+// speed at once.
 //
 // Between consecutive segments, and when the arm starts from rest or comes to rest, a
 // transition of 2 tau seconds centred on the via point keeps position and velocity continuous:
@@ -226,6 +229,11 @@ class TrajectoryGenerator {
     math::Transform fixed_goal;     ///< a position given in joints: its T6
     math::DriveTransform drive;     ///< cartesian: from the start (in the goal's frame) to I
     math::Transform start_in_goal;  ///< cartesian: drive.at(0), the line's start in G's frame
+    /// cartesian from rest onto a moving goal: the line starts where the arm stands
+    /// (start_world, fixed) and ends on the goal where it is at each sample, so that the arm
+    /// leaves rest without a jump of velocity (a start riding on the goal would move at once).
+    bool fixed_start = false;
+    math::Transform start_world;
     kin::Configuration configuration;
     bool has_configuration = false;
     /// The transition into it, as transition_tau chose it (a smooth pose blend that cannot be
