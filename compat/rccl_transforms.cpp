@@ -49,7 +49,7 @@ math::Transform functional_value(TrsfBox& b, const rc::SampleContext& ctx) {
   if (ctx.predicted) {
     math::Transform v = b.last_good;
     const double dt = b.last_t_s - b.previous_t_s;
-    if (b.previous_t_s < b.last_t_s && dt < 1.0) {
+    if (b.previous_t_s >= 0.0 && b.previous_t_s < b.last_t_s && dt < 1.0) {
       v.p += (b.last_good.p - b.previous_p) * ((ctx.t_s - b.last_t_s) / dt);
     }
     return v;
@@ -65,9 +65,13 @@ math::Transform functional_value(TrsfBox& b, const rc::SampleContext& ctx) {
   const auto& R = v.R;
   if (finite(
           {R.n.x, R.n.y, R.n.z, R.o.x, R.o.y, R.o.z, R.a.x, R.a.y, R.a.z, v.p.x, v.p.y, v.p.z})) {
-    if (ctx.how != nullptr && ctx.t_s > b.last_t_s) {
-      b.previous_p = b.last_good.p;
-      b.previous_t_s = b.last_t_s;
+    if (ctx.how != nullptr) {
+      if (ctx.t_s > b.last_t_s) {
+        b.previous_p = b.last_good.p;
+        b.previous_t_s = b.last_t_s;
+      } else {
+        b.previous_t_s = -1.0;  // time began again (a new session): no velocity known yet
+      }
       b.last_t_s = ctx.t_s;
     }
     b.last_good = v;

@@ -177,8 +177,10 @@ void TrajectoryGenerator::pose_at(const Segment& s, const SampleContext& ctx, do
   } else {
     s.position->evaluate(ctx, s.holds, out.goal, out.tool);
   }
-  out.frame = s.fixed_start ? math::DriveTransform(s.start_world, out.goal).at(r)
-                            : out.goal * s.drive.at(r);
+  out.frame = out.goal * s.drive.at(r);
+  // From rest onto a moving goal: the start stays where the arm stood, the end rides on the
+  // goal (the goal's displacement since the start, taken back in proportion to 1 - r).
+  if (s.fixed_start) out.frame.p += (s.start_goal_p - out.goal.p) * (1.0 - r);
   out.t6 = out.frame * out.tool.inverse();
 }
 
@@ -340,6 +342,7 @@ bool TrajectoryGenerator::build(const MotionRequest& r, const SampleContext& ctx
     s.start_in_goal = s.drive.at(0.0);
     s.fixed_start = cur_.kind == Segment::Kind::rest && pos.moves();
     s.start_world = frameB;
+    s.start_goal_p = goal.goal.p;
     // Walk the line before moving: a point out of reach or out of limits, or a joint that would
     // need more than its speed, is reported now rather than in the middle of the motion.
     constexpr int kChecks = 16;

@@ -6,9 +6,9 @@
 // goal, re-evaluated every sample so that a moving goal is tracked, D(r) Paul's drive transform
 // from the start, expressed in the goal's frame, to the goal; the inverse kinematics solved
 // every sample in the configuration the segment started in). A Cartesian segment from rest
-// onto a moving goal runs instead from where the arm stands (fixed) to the goal where it is at
-// each sample, F(t) = S D_t(r): a start riding on the goal would have to move at the goal's
-// speed at once.
+// onto a moving goal keeps its start where the arm stood: the goal's displacement since the
+// segment began is taken back in proportion to 1 - r (a start riding on the goal would have to
+// move at the goal's speed at once; a goal that turns still turns the start).
 //
 // Between consecutive segments, and when the arm starts from rest or comes to rest, a
 // transition of 2 tau seconds centred on the via point keeps position and velocity continuous:
@@ -234,6 +234,7 @@ class TrajectoryGenerator {
     /// leaves rest without a jump of velocity (a start riding on the goal would move at once).
     bool fixed_start = false;
     math::Transform start_world;
+    math::Vec3 start_goal_p;  ///< fixed_start: the goal's position when the segment was built
     kin::Configuration configuration;
     bool has_configuration = false;
     /// The transition into it, as transition_tau chose it (a smooth pose blend that cannot be
