@@ -27,10 +27,6 @@
 
 namespace rccx::compat {
 
-/// Set by the sample loop when a transform's function set nextmove with no generator to tell
-/// (taken at the next wait).
-std::atomic<bool> loop_saw_nextmove{false};
-
 State& state() {
   static State s;
   return s;
@@ -335,7 +331,7 @@ bool rccl_session_open() noexcept {
 
 void take_nextmove() noexcept {
   State& s = state();
-  if (loop_saw_nextmove.exchange(false) || nextmove != 0) {
+  if (nextmove != 0) {
     nextmove = 0;
     act_on_nextmove(s);
   }
@@ -551,7 +547,6 @@ int rccl_open(const char* robot, double period_ms) {
     s.configuration.clear();  // letters of the last session's robot
     t6_box().c.age = -1;
     nextmove = 0;
-    loop_saw_nextmove = false;
     park_position(s);
     to_c(measured_t6(s), t6_box().c);
     refresh();

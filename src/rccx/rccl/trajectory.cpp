@@ -603,6 +603,15 @@ double TrajectoryGenerator::plan_transition(const Segment& a, Segment& b, Blend 
   return tau;
 }
 
+void TrajectoryGenerator::add_peaks(const JointVector& q0, const JointVector& q1,
+                                    const JointVector& q2, double h, Peaks& pk) const noexcept {
+  for (std::size_t j = 0; j < q1.size(); ++j) {
+    const double acc = std::abs(q2[j] - 2.0 * q1[j] + q0[j]) / (h * h);
+    pk.acceleration = std::max(pk.acceleration, acc / options_.max_acceleration[j]);
+    pk.speed = std::max(pk.speed, std::abs(q2[j] - q1[j]) / h / options_.max_velocity[j]);
+  }
+}
+
 TrajectoryGenerator::Peaks TrajectoryGenerator::segment_peaks(const Segment& s,
                                                               const SampleContext& ctx,
                                                               const JointVector& near) const {
@@ -619,11 +628,7 @@ TrajectoryGenerator::Peaks TrajectoryGenerator::segment_peaks(const Segment& s,
     }
     for (double t = from + 2.0 * h; t <= to + 1e-9; t += h) {
       if (!segment_value(s, ctx, t, q1, q2, why)) return false;
-      for (std::size_t j = 0; j < q1.size(); ++j) {
-        const double acc = std::abs(q2[j] - 2.0 * q1[j] + q0[j]) / (h * h);
-        pk.acceleration = std::max(pk.acceleration, acc / options_.max_acceleration[j]);
-        pk.speed = std::max(pk.speed, std::abs(q2[j] - q1[j]) / h / options_.max_velocity[j]);
-      }
+      add_peaks(q0, q1, q2, h, pk);
       q0 = q1;
       q1 = q2;
     }
@@ -662,11 +667,7 @@ TrajectoryGenerator::Peaks TrajectoryGenerator::blend_peaks(const Segment& a, co
   if (!at(t - P, near, q0) || !at(t, q0, q1)) return pk;
   for (; t <= tB + tau + P; t += P) {
     if (!at(t + P, q1, q2)) return pk;
-    for (std::size_t j = 0; j < q1.size(); ++j) {
-      const double acc = std::abs(q2[j] - 2.0 * q1[j] + q0[j]) / (P * P);
-      pk.acceleration = std::max(pk.acceleration, acc / options_.max_acceleration[j]);
-      pk.speed = std::max(pk.speed, std::abs(q2[j] - q1[j]) / P / options_.max_velocity[j]);
-    }
+    add_peaks(q0, q1, q2, P, pk);
     q0 = q1;
     q1 = q2;
   }
@@ -917,31 +918,20 @@ void TrajectoryGenerator::fail(std::uint64_t id, const SampleContext& ctx, kin::
   };
   if (cur_.kind != Segment::Kind::rest) cancel(cur_);
   if (has_next_) cancel(next_);
-  if (waiting_) {
-    Segment w;
-    w.id = waiting_->id;
-    w.position = waiting_->position;
-    cancel(w);
-    withdraw_from(*waiting_, text);
-    waiting_.reset();
-  }
-  if (requeued_) {
-    Segment w;
-    w.id = requeued_->id;
-    w.position = requeued_->position;
-    cancel(w);
-    withdraw_from(*requeued_, text);
-    requeued_.reset();
-  }
-  joined_.reset();
-  MotionRequest r;
-  while (requests_.pop(r)) {
+  const auto cancel_request = [&](const MotionRequest& r) {
     Segment w;
     w.id = r.id;
     w.position = r.position;
     cancel(w);
     withdraw_from(r, text);
-  }
+  };
+  if (waiting_) cancel_request(*waiting_);
+  if (requeued_) cancel_request(*requeued_);
+  waiting_.reset();
+  requeued_.reset();
+  joined_.reset();
+  MotionRequest r;
+  while (requests_.pop(r)) cancel_request(r);
   has_next_ = false;
   tr_.active = false;
   ledger_.mark_failed(id, last);

@@ -316,6 +316,9 @@ class TrajectoryGenerator {
   /// period as the loop will run it (goals predicted at each sample's time), as multiples of the
   /// joints' bounds. `near`: joint values close to the transition's start, to seed the inverse
   /// kinematics.
+  /// Folds the speeds and accelerations of three setpoints h apart into pk (bound multiples).
+  void add_peaks(const kin::JointVector& q0, const kin::JointVector& q1, const kin::JointVector& q2,
+                 double h, Peaks& pk) const noexcept;
   Peaks blend_peaks(const Segment& a, const Segment& b, bool to_next, Blend blend, double tB,
                     double tau, const kin::JointVector& near, const SampleContext& ctx) const;
   /// The same for segment s's straight part (ts .. ts + T), seeded with `near` at its start.
