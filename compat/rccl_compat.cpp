@@ -882,7 +882,17 @@ int teach(TRSF_PTR trans, POS_PTR pos) {
     }
     const char* env = std::getenv("RCCX_DB");
     const std::string file = env != nullptr && env[0] != '\0' ? env : "rccx.db";
-    rc::PositionDb db(file);
+    std::unique_ptr<rc::PositionDb> opened;
+    try {
+      opened = std::make_unique<rc::PositionDb>(file);
+    } catch (const rc::DatabaseError& e) {
+      return fail(RTC_E_OPEN,
+                  fmt::format("teach({}): the position database {} cannot be used: {}; set "
+                              "RCCX_DB to a database file you can write",
+                              x->name, file, e.what()),
+                  Say::print);
+    }
+    rc::PositionDb& db = *opened;
     const std::string& robot = s.arm->kinematics().model().name;
     if (const auto stored = db.get(robot, x->name)) {
       to_c(stored->value, *trans);

@@ -455,6 +455,14 @@ TEST_F(CompatManual, TeachTakesAStoredTransformFromTheDatabase) {
   EXPECT_LT(position_error_mm(value_mm(*b) * math::Transform::translation(10, 20, 30)), 2.0);
   EXPECT_EQ(teach(t6, p), NO);
   EXPECT_EQ(rtc_error, RTC_E_ARGUMENT);
+  // A database that cannot be opened: NO, a message naming it, the transform unchanged.
+  ::setenv("RCCX_DB", "/nonexistent/dir/rccx.db", 1);
+  TRSF_PTR other = newtrans("OTHER", hold);
+  POS_PTR q = makeposition("Q", t6, EQ, b, other, TL, t6);
+  EXPECT_EQ(teach(other, q), NO);
+  EXPECT_EQ(rtc_error, RTC_E_OPEN);
+  EXPECT_NE(message().find("/nonexistent/dir/rccx.db"), std::string::npos) << message();
+  EXPECT_EQ(other->p.z, 0.0);
   EXPECT_EQ(rccl_close(0), RTC_OK) << message();
   std::filesystem::remove(db);
 }
