@@ -108,6 +108,42 @@ TEST(RcclGeneratorRobust, MicroboWristTurnBlendedIntoACartesianDepartureStaysWit
   EXPECT_LE(p.acceleration, 1.0 + rccl::kAccelerationTolerance);
 }
 
+// The issue's retry: the wrist turn asked as a Cartesian line. A line takes the shorter way
+// round (here 100 deg down from -200 deg), which would take joint 6 past its -250 deg limit; the
+// solver then gives the other turn of the same angle and joint 6 would jump. Before, the message
+// blamed a singularity (joint 5 at -90 deg is none); now it names joint 6 and its limit, and
+// says that joint mode turns it the other way, which then runs.
+TEST(RcclGeneratorRobust, ACartesianLinePastAMultiTurnJointsLimitIsRefusedNamingTheLimit) {
+  GeneratorRun run("microbo", 0.028);
+  rccl::MotionSettings cart;
+  cart.mode = Mode::cartesian;
+  cart.translation_m_per_s = 0.05;
+  cart.rotation_rad_per_s = 1.0;
+  rccl::MotionSettings joint = cart;
+  joint.mode = Mode::joint;
+  const auto q = [](double q6) { return kin::JointVector{0.3, 0.21, 0.35, 90_deg, -90_deg, q6}; };
+  const auto start = run.move(rccl::Position::joints("START", q(-200_deg)), joint);
+  ASSERT_TRUE(run.run_until_ended(start));
+  const auto line = run.move(pose_position("TURNED", run.kinematics->forward(q(60_deg))), cart);
+  ASSERT_TRUE(run.run_until_rest());
+  const rccl::MotionEvent* failed = run.find_event(EventKind::failed);
+  ASSERT_NE(failed, nullptr) << "the line should not have run";
+  EXPECT_EQ(failed->id, line);
+  const std::string why(failed->message());
+  EXPECT_NE(why.find("joint 6 past its limit (-250.0 deg)"), std::string::npos) << why;
+  EXPECT_EQ(why.find("singularity"), std::string::npos) << why;
+  // Nothing moved for the refused line: the arm still stands at the start.
+  EXPECT_NEAR(run.q[5], -200_deg, 1e-5);
+  // Joint mode turns it the long way round, within its limits.
+  run.events.clear();
+  const auto turn = run.move(pose_position("TURNED", run.kinematics->forward(q(60_deg))), joint);
+  ASSERT_TRUE(run.run_until_rest());
+  ASSERT_EQ(run.find_event(EventKind::failed), nullptr)
+      << run.find_event(EventKind::failed)->message();
+  EXPECT_GE(run.event_time(EventKind::ended, turn), 0.0);
+  EXPECT_NEAR(run.q[5], 60_deg, 1e-6);
+}
+
 }  // namespace
 
 // --- Configurations (issue 14, item 3) ----------------------------------------------------------

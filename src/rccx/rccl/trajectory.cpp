@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 
 #include "rccx/rccl/paul_transition.hpp"
 #include "rccx/rtc/types.hpp"
@@ -225,7 +226,11 @@ bool TrajectoryGenerator::segment_value(const Segment& s, const SampleContext& c
       // leave the workspace or a joint's limits although the blend does not: continue it in
       // joint space there, at the rate it has at its end.
       const double r_end = r < 0.0 ? 0.0 : 1.0;
-      const double h = r < 0.0 ? 0.01 : -0.01;  // a step back onto the line
+      // A step back onto the line, under a period: the tangent must be the line's derivative at
+      // its end, or the blend's velocity jumps where the line takes over (near a singularity the
+      // joints' rates change fast along the line).
+      const double step = std::min(0.01, 0.5 * options_.period_s / s.T);
+      const double h = r < 0.0 ? step : -step;
       Pose pe, pi;
       pose_at(s, c, r_end, pe);
       pose_at(s, c, r_end + h, pi);
@@ -357,13 +362,25 @@ bool TrajectoryGenerator::build(const MotionRequest& r, const SampleContext& ctx
                   100.0 * k / kChecks, kin::describe(why)));
         return false;
       }
+      bool at_limit = false;
       const int jumping = find_jump(s, ctx, static_cast<double>(k - 1) / kChecks,
-                                    static_cast<double>(k) / kChecks, q_prev, q);
+                                    static_cast<double>(k) / kChecks, q_prev, q, at_limit);
+      if (jumping > 0 && at_limit) {
+        const auto J = static_cast<std::size_t>(jumping - 1);
+        const bool revolute = kin_.model().joints[J].type == kin::JointType::revolute;
+        const double limit = q_prev[J] < q[J] ? lower_[J] : upper_[J];
+        fail(r.id, ctx, kin::IkStatus::joint_limits, jumping,
+             text("the straight line to {} turns joint {} past its limit ({:.1f} {}) about "
+                  "{:.0f}% of the way (the line takes the shorter way round); move in joint "
+                  "mode, which turns it the other way, or add a via point",
+                  name, jumping, revolute ? limit * 180.0 / std::numbers::pi : limit * 1000.0,
+                  revolute ? "deg" : "mm", 100.0 * (k - 0.5) / kChecks));
+        return false;
+      }
       if (jumping > 0) {
         fail(r.id, ctx, kin::IkStatus::singular, jumping,
              text("the straight line to {} passes through a singularity about {:.0f}% of the "
-                  "way: joint {} would jump there (or it is at the end of its turns); go round "
-                  "it (another line or a via point) "
+                  "way: joint {} would jump there; go round it (another line or a via point) "
                   "or move in joint mode",
                   name, 100.0 * (k - 0.5) / kChecks, jumping));
         return false;
@@ -432,7 +449,8 @@ bool TrajectoryGenerator::build(const MotionRequest& r, const SampleContext& ctx
 }
 
 int TrajectoryGenerator::find_jump(const Segment& s, const SampleContext& ctx, double r0, double r1,
-                                   const JointVector& q0, const JointVector& q1) const {
+                                   const JointVector& q0, const JointVector& q1,
+                                   bool& at_limit) const {
   // A joint that turns a lot between two points of the line is either fast there (fine, the
   // segment time allows for it) or jumping: a change of solution branch at a singularity.
   // Halving the interval tells them apart: a smooth change halves, a jump stays.
@@ -462,7 +480,15 @@ int TrajectoryGenerator::find_jump(const Segment& s, const SampleContext& ctx, d
       lo = mid;
     }
   }
-  return std::abs(hi[J] - lo[J]) > 0.5 * largest ? joint + 1 : 0;
+  if (!(std::abs(hi[J] - lo[J]) > 0.5 * largest)) return 0;
+  // A joint of several turns that the line would take past its limit: the solver gives the
+  // same angle a turn the other way round, and the jump's near side sits on the limit.
+  constexpr double kAtLimit = 1e-2;  // rad or m
+  const auto near_limit = [&](double v) {
+    return std::abs(v - lower_[J]) < kAtLimit || std::abs(v - upper_[J]) < kAtLimit;
+  };
+  at_limit = near_limit(lo[J]) || near_limit(hi[J]);
+  return joint + 1;
 }
 
 // --- Transitions ---------------------------------------------------------------------------------

@@ -300,9 +300,11 @@ class TrajectoryGenerator {
   /// Cancels the requests from `id` on with `why`, withdrawing them from their rendezvous.
   void withdraw_from(const MotionRequest& r, const Text& why) noexcept;
   /// The 1-based joint whose solution jumps between drive fractions r0 and r1 of Cartesian
-  /// segment s (solved as q0, q1): a singularity on the line. 0: none.
+  /// segment s (solved as q0, q1): a singularity on the line, or (at_limit) the end of the
+  /// joint's travel, where the solver turns it the other way round. 0: none.
   [[nodiscard]] int find_jump(const Segment& s, const SampleContext& ctx, double r0, double r1,
-                              const kin::JointVector& q0, const kin::JointVector& q1) const;
+                              const kin::JointVector& q0, const kin::JointVector& q1,
+                              bool& at_limit) const;
   [[nodiscard]] Blend blend_between(const Segment& a, const Segment* b) const noexcept;
   /// Half the transition from a into b at via time tB, from the change of joint velocity and
   /// the acceleration bound; lengthens b (not started yet) when a has too little room left.
