@@ -120,7 +120,20 @@ void run_programs(const char* robot, double period, std::uint64_t seed, std::siz
       ++tally.motions;
     }
     const std::size_t from = run.qs.size();
-    ASSERT_TRUE(run.run_until_rest(600.0)) << robot << " program " << program << " never rested";
+    if (!run.run_until_rest(600.0) && std::getenv("RCCX_PROPERTY_DEBUG")) {
+      for (const auto& ev : run.events) {
+        std::printf("%s %llu %.3f %s\n", std::string(rccl::to_string(ev.kind)).c_str(),
+                    static_cast<unsigned long long>(ev.id), ev.t_s,
+                    std::string(ev.message()).c_str());
+      }
+      for (std::size_t k = from; k < run.qs.size(); k += 500) {
+        std::printf("t %.3f seg %llu q [%s]\n", run.t[k],
+                    static_cast<unsigned long long>(run.segment[k]),
+                    fmt::format("{:.4f}", fmt::join(run.qs[k], ", ")).c_str());
+      }
+    }
+    ASSERT_TRUE(run.generator.at_rest()) << robot << " program " << program << " never rested\n"
+                                         << plan;
     bool failed = false;
     for (const auto& e : run.events) {
       if (e.kind == EventKind::ended) ++tally.ended;

@@ -60,7 +60,7 @@ constexpr double kSegmentChecks = 1024.0;
 /// A Cartesian segment is slowed at most this much for its own sake (its joints' speeds and
 /// accelerations along the line); one that would need more is refused as too close to a
 /// singularity.
-constexpr double kMaxSegmentStretch = 50.0;
+constexpr double kMaxSegmentStretch = 20.0;
 /// ... and its first and last this many periods, every period.
 constexpr double kEndChecks = 32.0;
 
@@ -399,16 +399,31 @@ bool TrajectoryGenerator::build(const MotionRequest& r, const SampleContext& ctx
     // acceleration (from the curvature of the path in joint space) peak between them. Sample
     // the line as it will run and slow it down (a longer T: speed falls as 1 / T, acceleration
     // as 1 / T^2) until it keeps within the planning fractions of both bounds.
+    // The coarse sweeps (T / 1024) converge fast; the last word is a sweep every period, which
+    // is what the loop will run (a stretched line's peak near a singularity can fall between
+    // coarse samples).
     const double T0 = s.T;
+    bool every_period = false;
     for (int pass = 0;; ++pass) {
-      const Peaks pk = segment_peaks(s, ctx, qB);
-      if (!pk.ok) break;
+      const Peaks pk = segment_peaks(s, ctx, qB, every_period);
+      if (!pk.ok) {
+        // Between the checks above the line has no solution (it grazes the workspace's edge
+        // or a singularity there): it cannot be run at any speed.
+        fail(r.id, ctx, pk.why, 0,
+             text("the straight line to {} leaves the workspace about {:.0f}% of the way: {}", name,
+                  100.0 * std::clamp(pk.unsolved_s / s.T, 0.0, 1.0), kin::describe(pk.why)));
+        return false;
+      }
       const double k = std::max(pk.speed / kPlanningSpeedFraction,
                                 std::sqrt(pk.acceleration / kPlanningAccelerationFraction));
-      if (!(k > 1.0)) break;
+      if (!(k > 1.0)) {
+        if (every_period || pos.moves()) break;
+        every_period = true;
+        continue;
+      }
       // (A moving goal's own motion is not the line's: it cannot be slowed, and the loop's guards
       // judge it as it comes.)
-      if (s.T >= kMaxSegmentStretch * T0 && !pos.moves()) {
+      if ((s.T >= kMaxSegmentStretch * T0 || pass >= 3 * kPlanningPasses) && !pos.moves()) {
         // No speed the line may be taken at keeps the joints within their bounds: it runs too
         // close to a singularity (or the edge of the workspace).
         fail(r.id, ctx, kin::IkStatus::singular, 0,
@@ -418,7 +433,7 @@ bool TrajectoryGenerator::build(const MotionRequest& r, const SampleContext& ctx
                   name, s.T / T0, k));
         return false;
       }
-      if (pass == 2 * kPlanningPasses || s.T >= kMaxSegmentStretch * T0) break;
+      if (pos.moves() && (pass == 2 * kPlanningPasses || s.T >= kMaxSegmentStretch * T0)) break;
       s.T *= std::min(1.02 * k, kMaxSegmentStretch * T0 / s.T);
     }
   }
@@ -640,20 +655,24 @@ void TrajectoryGenerator::add_peaks(const JointVector& q0, const JointVector& q1
 
 TrajectoryGenerator::Peaks TrajectoryGenerator::segment_peaks(const Segment& s,
                                                               const SampleContext& ctx,
-                                                              const JointVector& near) const {
+                                                              const JointVector& near,
+                                                              bool every_period) const {
   // Every period, or T / kSegmentChecks when that is longer (a bounded cost per segment: the
   // second difference over a longer step still sees a peak, somewhat smoothed); and both ends
   // every period, where a line that starts or ends near a singularity bends most.
   Peaks pk;
   kin::IkStatus why;
+  const auto unsolved = [&](double t) {
+    pk.why = why;
+    pk.unsolved_s = t - s.ts;
+    return false;
+  };
   const auto sweep = [&](double from, double to, double h, const JointVector& seed) {
     JointVector q0, q1, q2;
-    if (!segment_value(s, ctx, from, seed, q0, why) ||
-        !segment_value(s, ctx, from + h, q0, q1, why)) {
-      return false;
-    }
+    if (!segment_value(s, ctx, from, seed, q0, why)) return unsolved(from);
+    if (!segment_value(s, ctx, from + h, q0, q1, why)) return unsolved(from + h);
     for (double t = from + 2.0 * h; t <= to + 1e-9; t += h) {
-      if (!segment_value(s, ctx, t, q1, q2, why)) return false;
+      if (!segment_value(s, ctx, t, q1, q2, why)) return unsolved(t);
       add_peaks(q0, q1, q2, h, pk);
       q0 = q1;
       q1 = q2;
@@ -661,6 +680,11 @@ TrajectoryGenerator::Peaks TrajectoryGenerator::segment_peaks(const Segment& s,
     return true;
   };
   const double P = options_.period_s;
+  if (every_period) {
+    if (!sweep(s.ts, s.ts + s.T, P, near)) return pk;
+    pk.ok = true;
+    return pk;
+  }
   const double h = std::max(P, s.T / kSegmentChecks);
   const double end = std::min(s.T, kEndChecks * P);
   if (!sweep(s.ts, s.ts + s.T, h, near) || !sweep(s.ts, s.ts + end, P, near) ||

@@ -33,15 +33,17 @@
 // lengthened (and the next segment with it, when it must), while one would pass
 // kTransitionSpeedFraction of its top speed the next segment is slowed (its velocity scales as
 // 1 / T); the segment now running is never changed, and its room bounds the transition. Every
-// Cartesian segment is sampled along its line (T / 1024, and every period near both ends) and
-// lengthened as a whole until its joints keep within kPlanningSpeedFraction of their top speeds
-// and kPlanningAccelerationFraction of their bounds. The planned setpoints then keep every
-// joint within its top speed and within its acceleration bound times
-// 1 + kAccelerationTolerance. A motion fails only when no slower timing helps: a line through
-// a singularity (a joint would jump), one that leaves the workspace, one that even
-// 50 times slower would pass a bound ("too close to a singularity"); the message
-// says which. The sample loop's guards (top speed, twice the acceleration bound, limits) stay as
-// the last defence and stop the arm smoothly with their own message.
+// Cartesian segment is sampled along its line (T / 1024, and every period near both ends; then
+// every period, as the loop will run it) and lengthened as a whole until its joints keep within
+// kPlanningSpeedFraction of their top speeds and kPlanningAccelerationFraction of their bounds.
+// The planned setpoints then keep every joint within its top speed and within its acceleration
+// bound times 1 + kAccelerationTolerance. A motion fails, before it starts, only when no
+// slower timing helps: a line through a singularity (a joint would jump), one that leaves the
+// workspace anywhere along it, one that would turn a joint past its limit, one that even
+// 20 times slower would pass a bound ("too close to a singularity": the time is stretched
+// uniformly, so a line that grazes a singularity near one end would otherwise crawl for
+// minutes); the message says which. The sample loop's guards (top speed, twice the acceleration
+// bound, limits) stay as the last defence and stop the arm smoothly with their own message.
 //
 // The generator owns the two lock-free queues between the planning level and the loop:
 // requests in, events out. Nothing in step() allocates, locks or throws.
@@ -256,6 +258,8 @@ class TrajectoryGenerator {
   struct Peaks {
     bool ok = false;  ///< false: a sample has no solution
     double speed = 0.0, acceleration = 0.0;
+    kin::IkStatus why = kin::IkStatus::ok;  ///< !ok: the kinematics' reason
+    double unsolved_s = 0.0;                ///< !ok: the sample's time from the segment's start
     [[nodiscard]] double ratio_or_failed() const noexcept { return ok ? acceleration : -1.0; }
   };
   struct Transition {
@@ -323,9 +327,10 @@ class TrajectoryGenerator {
                  double h, Peaks& pk) const noexcept;
   Peaks blend_peaks(const Segment& a, const Segment& b, bool to_next, Blend blend, double tB,
                     double tau, const kin::JointVector& near, const SampleContext& ctx) const;
-  /// The same for segment s's straight part (ts .. ts + T), seeded with `near` at its start.
-  Peaks segment_peaks(const Segment& s, const SampleContext& ctx,
-                      const kin::JointVector& near) const;
+  /// The same for segment s's straight part (ts .. ts + T), seeded with `near` at its start:
+  /// every T / kSegmentChecks and every period near both ends, or (every_period) every period.
+  Peaks segment_peaks(const Segment& s, const SampleContext& ctx, const kin::JointVector& near,
+                      bool every_period = false) const;
   /// The velocities of a and b at the via point tB, for the smooth blends; false when a value
   /// has no solution.
   bool tangents(const Segment& a, const Segment& b, Blend blend, double tB,
