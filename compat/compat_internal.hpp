@@ -93,6 +93,12 @@ struct State {
   std::unique_ptr<rc::Manipulator> arm;
   bool controlling = false;  ///< rccl_control() was called in this session
   bool told_ended = false;   ///< the end of control was printed
+  /// The session main() opened for a manual-style pumatask(): the task's own rccl_open and
+  /// rccl_control are then accepted (rccl_open reopens it as asked while nothing has moved).
+  bool opened_for_task = false;
+  /// The sample at which every queued motion had ended (0: not yet): `completed` waits from
+  /// there for the measured arm to come to rest, at most kSettleTimeout_s.
+  std::uint64_t ended_at_sample = 0;
   std::size_t failures_seen = 0;
   std::size_t refused_moves = 0;  ///< move() calls that failed in this session
   int first_refusal_code = RTC_OK;
@@ -108,6 +114,9 @@ struct State {
 };
 
 State& state();
+/// For rccl_main.cpp (which declares them itself: it sees only the C headers).
+void mark_session_for_task() noexcept;
+bool session_open() noexcept;
 TrsfBox& t6_box();
 POS& park_box();
 

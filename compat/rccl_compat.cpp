@@ -63,6 +63,45 @@ int fail(int code, std::string_view text, Say say) noexcept {
   return code;
 }
 
+namespace {
+
+/// `completed` also waits for the measured arm to stop (every joint under this fraction of its
+/// top speed): a follower such as the Microbo's RCU trails the setpoints by a few samples, and
+/// a program that reads t6 once its motions are complete expects the arm there.
+constexpr double kSettledSpeedFraction = 0.002;
+/// ... but at most this long after the last motion ended (an arm that keeps trembling).
+constexpr double kSettleTimeout_s = 1.0;
+
+bool arm_settled(State& s, bool ended) noexcept {
+  if (!ended) {
+    s.ended_at_sample = 0;
+    return false;
+  }
+  if (!s.robot || !s.controlling || !s.robot->session->controlling()) return true;
+  const rtc::Session& session = *s.robot->session;
+  const rtc::How how = session.how();
+  if (s.ended_at_sample == 0) s.ended_at_sample = std::max<std::uint64_t>(how.sample, 1);
+  const double waited_s = static_cast<double>(how.sample - s.ended_at_sample) *
+                          std::chrono::duration<double>(session.period()).count();
+  if (waited_s >= kSettleTimeout_s) return true;
+  const auto& joints = s.arm->kinematics().model().joints;
+  for (std::size_t j = 0; j < how.dof && j < joints.size(); ++j) {
+    if (std::abs(how.joint[j].velocity) > kSettledSpeedFraction * joints[j].max_velocity) {
+      return false;
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
+void mark_session_for_task() noexcept {
+  state().opened_for_task = true;
+}
+bool session_open() noexcept {
+  return state().robot != nullptr;
+}
+
 void refresh() noexcept {
   State& s = state();
   for (auto& [key, box] : s.positions) {
@@ -72,7 +111,7 @@ void refresh() noexcept {
     box->shown->end = box->queued.empty() ? 1 : 0;
   }
   if (s.arm) {
-    completed = s.arm->happened(rc::Manipulator::completed()) ? 1 : 0;
+    completed = arm_settled(s, s.arm->happened(rc::Manipulator::completed())) ? 1 : 0;
   } else if (s.cell) {
     completed = 1;
     for (const auto& [name, m] : s.manips) {
@@ -510,6 +549,12 @@ POS_PTR makeposition(const char* name, ...) {
 int rccl_open(const char* robot, double period_ms) {
   return guarded("rccl_open", Say::quiet, RTC_E_ROBOT, [&] {
     State& s = state();
+    if (s.robot && s.opened_for_task) {
+      // pumatask() opening the session main() opened for it: as it asks, if nothing has moved.
+      if (!s.motion_names.empty()) return RTC_OK;
+      s.opened_for_task = false;
+      if (const int code = rccl_close(0); code != RTC_OK) return code;
+    }
     if (s.robot) {
       return fail(RTC_E_SEQUENCE, "rccl_open: a session is open already; rccl_close() it first",
                   Say::quiet);
@@ -558,6 +603,7 @@ int rccl_control(void) {
   return guarded("rccl_control", Say::quiet, RTC_E_INTERNAL, [] {
     State& s = state();
     if (!s.arm) return fail(RTC_E_SEQUENCE, "rccl_control: call rccl_open() first", Say::quiet);
+    if (s.controlling && s.opened_for_task) return RTC_OK;
     if (s.controlling) {
       return fail(RTC_E_SEQUENCE, "rccl_control: the trajectory generator runs already",
                   Say::quiet);
@@ -594,6 +640,16 @@ int rccl_close(int power_off) {
     int code = RTC_OK;
     std::string why;
     if (s.controlling) report_failures();
+    // The motions have ended: let the arm come to rest before control stops (bounded).
+    if (s.controlling && s.robot->session->controlling() &&
+        s.arm->happened(rc::Manipulator::completed())) {
+      rtc::Session& session = *s.robot->session;
+      refresh();
+      while (completed == 0 && session.controlling()) {
+        session.wait_for(session.period());
+        refresh();
+      }
+    }
     const rtc::Termination t =
         s.controlling ? s.arm->stop_control() : s.robot->session->termination();
     const std::vector<rc::MotionEvent>& failures = s.arm->failures();

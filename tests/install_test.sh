@@ -2,7 +2,8 @@
 # rccx installed and used from outside the tree: `cmake --install` into a temporary prefix, then
 #   1. an outside CMake project (tests/install/) with find_package(rccx): a C++ program over
 #      rccx::rccl and a 1986 C program (examples/cell_handoff.c) over rccx::compat;
-#   2. the thesis's washer.c built with plain cc and `pkg-config --cflags --libs rccx-compat`.
+#   2. the thesis's washer.c, a manual-style guarded motion and a pumatask() program with no
+#      main() built with plain cc and `pkg-config --cflags --libs rccx-compat`.
 # Each program runs on the simulated robots and must do what it says.
 # Usage: install_test.sh BUILD_DIR SOURCE_DIR "SANITIZER FLAGS (may be empty)"
 set -euo pipefail
@@ -44,4 +45,11 @@ cc -std=gnu89 -Werror=implicit-function-declaration -o "$work/guarded" \
 out=$(RCCX_LOG="$work/guarded.csv" "$work/guarded")
 echo "$out" | tail -1
 grep -q "touched at z = " <<< "$out" && test "$(wc -l < "$work/guarded.csv")" -gt 10
+# As the manual prints them: rccl.h and manex.h, pumatask() and no main() (rccx_compat_main's).
+# shellcheck disable=SC2046,SC2086
+cc -std=gnu89 -w -Werror=implicit-function-declaration -o "$work/pumatask" \
+  "$source/examples/c/pumatask.c" $flags $(pkg-config --cflags --libs rccx-compat)
+out=$("$work/pumatask")
+echo "$out" | tail -1
+grep -q "square drawn" <<< "$out"
 echo "install_test: the CMake package and rccx-compat.pc build and run programs from outside"

@@ -60,8 +60,10 @@ class Registry {
 };
 
 Registry& registry() {
-  static Registry r;
-  return r;
+  // Never destroyed: a session may still be released by another static's destructor at exit
+  // (a C program that calls exit() with its session open), after this one would have gone.
+  static Registry* const r = new Registry;
+  return *r;
 }
 
 }  // namespace
