@@ -4,7 +4,8 @@
  *
  * CONV is the belt's displacement: its function, called once a sample, moves it along y at
  * SPEED mm/s from the moment the belt starts. The arm joins a part on the belt with a
- * Cartesian transition, rides along with it for two seconds, and leaves. Prints the largest
+ * Cartesian transition, rides along with it for two seconds, rises off it still following it,
+ * and leaves for park in joint mode. Prints the largest
  * distance between the measured tool and the part while riding, and exits 1 above 3 mm.
  *
  *   cc conveyor.c $(pkg-config --cflags --libs rccx-compat) && ./a.out
@@ -68,8 +69,11 @@ int main()
   }
   printf("rode %.0f mm along the belt at %.0f mm/s; the tool was within %.2f mm of the part\n",
          conv->p.y, SPEED, worst);
+  distance("dz", -40.);
+  move(ride);         /* up off the part, still following it */
   setmod('j');
-  move(park); /* off the belt, a transition out of the tracking */
+  move(park); /* off the belt, a transition out of the tracking (the belt carries the part
+                 out of reach meanwhile) */
   waitfor(completed);
   if (rccl_close(0)) {
     print_rtc_error(rtc_error, 0);

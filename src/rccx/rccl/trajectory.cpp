@@ -223,21 +223,25 @@ bool TrajectoryGenerator::segment_value(const Segment& s, const SampleContext& c
       if ((inside || !linear_past_ends) && solve(s, p.t6, near, q, why)) return true;
       if (inside) return false;
       // Past its ends (a transition blends the segments extended beyond them) the line may
-      // leave the workspace or a joint's limits although the blend does not: continue it in
-      // joint space there, at the rate it has at its end.
+      // leave the workspace or a joint's limits although the blend does not, and a moving goal
+      // may carry it out of reach (a conveyor's part the arm is leaving): continue it in joint
+      // space from where it is at its end, at the velocity it has there (its drive's and its
+      // goal's), from a value a step before, under a period: the tangent must be the
+      // derivative at the end, or the blend's velocity jumps where the line takes over (near a
+      // singularity the joints' rates change fast along the line).
       const double r_end = r < 0.0 ? 0.0 : 1.0;
-      // A step back onto the line, under a period: the tangent must be the line's derivative at
-      // its end, or the blend's velocity jumps where the line takes over (near a singularity the
-      // joints' rates change fast along the line).
-      const double step = std::min(0.01, 0.5 * options_.period_s / s.T);
-      const double h = r < 0.0 ? step : -step;
+      const double t_end = r < 0.0 ? s.ts : s.ts + s.T;
+      const double step = std::min(0.01 * s.T, 0.5 * options_.period_s);
+      const double t_in = r < 0.0 ? t_end + step : t_end - step;
       Pose pe, pi;
-      pose_at(s, c, r_end, pe);
-      pose_at(s, c, r_end + h, pi);
+      pose_at(s, at_time(ctx, t_end), r_end, pe);
+      pose_at(s, at_time(ctx, t_in), fraction(s, t_in), pi);
       JointVector q_end, q_in;
       if (!solve(s, pe.t6, near, q_end, why) || !solve(s, pi.t6, q_end, q_in, why)) return false;
       q = q_end;
-      for (std::size_t j = 0; j < q.size(); ++j) q[j] += (q_in[j] - q_end[j]) / h * (r - r_end);
+      for (std::size_t j = 0; j < q.size(); ++j) {
+        q[j] += (q_in[j] - q_end[j]) / (t_in - t_end) * (t - t_end);
+      }
       return true;
     }
   }
