@@ -298,6 +298,55 @@ TEST(RcclConfiguration, GoalOutsideThePresentConfigurationIsRefusedAtTheCall) {
 // transition (lengthened by the generator as the bounds need) and tracked: the measured tool
 // point (forward kinematics of the joints as read) against the part where the belt has it at
 // the time of that reading, once the arm has joined it.
+// RCCL's stop(ms) after a motion onto a moving goal: the arm stays on that position for the
+// time, riding along with the conveyor (before, the dwell froze the joints and the belt left the
+// tool behind); the dwell ends on time and the next motion starts from the belt.
+TEST(RcclGeneratorRobust, ADwellOnAMovingGoalKeepsTrackingIt) {
+  rtc::SimulatedRobot robot(kin::builtin_robot("puma560"));
+  rccl::Manipulator arm(*robot.session);
+  const kin::Kinematics& kin = arm.kinematics();
+  arm.start();
+  constexpr double kSpeed = 0.1;  // m/s along y
+  const math::Transform start{math::Rot3::rot_x(180_deg), {0.45, -0.2, 0.0}};
+  double t_belt0 = -1.0;
+  const auto belt_at = [&](double t) {
+    const double dt = t_belt0 < 0.0 ? 0.0 : std::max(0.0, t - t_belt0);
+    return math::Transform::translation(0.0, kSpeed * dt, 0.0);
+  };
+  const auto conv =
+      rccl::functional("CONV", [&](const rccl::SampleContext& ctx) { return belt_at(ctx.t_s); });
+  const auto t6 = rccl::t6();
+  const auto part = rccl::Position::make("PART", {t6}, {conv, rccl::constant("START", start)}, t6);
+  arm.set_configuration("ruf");
+  ASSERT_EQ(arm.waitfor(arm.move(pose_position("OVER", start)).end()), rccl::WaitResult::reached);
+  arm.set_configuration("");
+  arm.set_mode(Mode::cartesian);
+  t_belt0 = robot.session->how().time_s;
+  ASSERT_EQ(arm.waitfor(arm.move(part).end(), 5s), rccl::WaitResult::reached);
+  const rccl::Motion dwell = arm.dwell(1.5);
+  const double dwell_from = robot.session->how().time_s;
+  double worst = 0.0;
+  while (!arm.happened(dwell.end())) {
+    robot.session->wait_for(10ms);
+    const rtc::How h = robot.session->how();
+    worst = std::max(worst, (kin.forward(h.q()).p - (belt_at(h.time_s) * start).p).norm());
+    ASSERT_LT(h.time_s - dwell_from, 3.0) << "the dwell did not end";
+  }
+  const double dwell_s = robot.session->how().time_s - dwell_from;
+  std::printf("a 1.5 s dwell on the belt took %.3f s; the tool stayed within %.2f mm of the part\n",
+              dwell_s, worst * 1e3);
+  EXPECT_LT(worst, 2e-3);
+  EXPECT_GE(dwell_s, 1.5 - 0.03);  // its time, plus the transitions in and out at most
+  EXPECT_LT(dwell_s, 1.8);
+  // Off the belt to a fixed pose: from the moving goal, with no failure.
+  arm.set_mode(Mode::joint);
+  ASSERT_EQ(arm.waitfor(arm.move(pose_position("OVER", start)).end(), 10s),
+            rccl::WaitResult::reached);
+  EXPECT_TRUE(arm.failures().empty())
+      << (arm.failures().empty() ? "" : arm.failures().front().message());
+  arm.halt();
+}
+
 TEST(RcclGeneratorRobust, AConveyorAtHalfAMetreASecondIsJoinedAndTrackedWithin2mm) {
   rtc::SimulatedRobot robot(kin::builtin_robot("puma560"));
   rccl::Manipulator arm(*robot.session);

@@ -278,6 +278,20 @@ bool TrajectoryGenerator::build(const MotionRequest& r, const SampleContext& ctx
   if (r.kind == RequestKind::dwell) {
     s.kind = Segment::Kind::joint;
     s.q1 = qB;
+    if (cur_.kind == Segment::Kind::cartesian && cur_.position != nullptr &&
+        cur_.position->moves()) {
+      // RCCL's stop(): the arm stays on the last position for the time, and a position that
+      // moves (a conveyor) is tracked meanwhile: the same equation, its drive at its end.
+      s.kind = Segment::Kind::cartesian;
+      s.position = cur_.position;
+      s.borrowed_position = true;
+      s.holds = cur_.holds;
+      s.fixed_goal = cur_.fixed_goal;
+      s.drive = math::DriveTransform(math::Transform::identity(), math::Transform::identity());
+      s.start_in_goal = math::Transform::identity();
+      s.configuration = cur_.configuration;
+      s.has_configuration = cur_.has_configuration;
+    }
     s.T = std::max(r.dwell_s, options_.period_s);
     s.stop_tau = std::max(options_.period_s, 0.5 * s.settings.transition_time_s);
     next_ = s;
@@ -926,7 +940,9 @@ void TrajectoryGenerator::end_motion(const Segment& s, const SampleContext& ctx,
   if (s.id == 0) return;
   SegmentReport& rep = reports_[s.id % kReports];
   if (rep.id == s.id) rep.end_s = ctx.t_s;
-  if (s.position != nullptr) s.position->pending_ends.fetch_sub(1, std::memory_order_acq_rel);
+  if (s.position != nullptr && !s.borrowed_position) {
+    s.position->pending_ends.fetch_sub(1, std::memory_order_acq_rel);
+  }
   emit(EventKind::ended, s.id, ctx, kin::IkStatus::ok, 0, text);
   ledger_.mark_ended(s.id);
 }
@@ -967,7 +983,9 @@ void TrajectoryGenerator::fail(std::uint64_t id, const SampleContext& ctx, kin::
   const auto cancel = [&](const Segment& s) {
     if (s.id == 0) return;
     if (s.id != id) emit(EventKind::cancelled, s.id, ctx);
-    if (s.position != nullptr) s.position->pending_ends.fetch_sub(1, std::memory_order_acq_rel);
+    if (s.position != nullptr && !s.borrowed_position) {
+      s.position->pending_ends.fetch_sub(1, std::memory_order_acq_rel);
+    }
     last = std::max(last, s.id);
   };
   if (cur_.kind != Segment::Kind::rest) cancel(cur_);

@@ -221,6 +221,9 @@ class TrajectoryGenerator {
     Kind kind = Kind::rest;
     bool resting = false;  ///< cartesian: r stays 1 (tracking a moving goal)
     const Position* position = nullptr;
+    /// A dwell (stop) on a moving goal: it tracks the position of the motion before it, which
+    /// it does not own (that motion's end was counted already).
+    bool borrowed_position = false;
     std::uint64_t id = 0;  ///< 0: not a motion (rest)
     MotionSettings settings;
     double ts = 0.0, T = 1.0;  ///< the straight part starts at ts (the via time) and lasts T, s
