@@ -177,6 +177,23 @@ void TrajectoryGenerator::pose_at(const Segment& s, const SampleContext& ctx, do
     out.tool = math::Transform::identity();
   } else {
     s.position->evaluate(ctx, s.holds, out.goal, out.tool);
+    const Segment& owner = tr_.active && tr_.to_next ? next_ : cur_;
+    if (!ctx.predicted && s.id == owner.id && s.position == owner.position) {
+      // The present segment's goal as the loop sees it, once a sample: how far its step
+      // changed names a goal that jumped when a guard stops the arm.
+      GoalTrack& g = goal_track_;
+      if (g.position != s.position) {  // (a motion's end keeps it: the arm tracks on)
+        g = GoalTrack{};
+        g.position = s.position;
+      }
+      if (!(ctx.t_s <= g.t_s + 1e-9) || g.samples == 0) {
+        g.jump_m = g.samples >= 2 ? ((out.goal.p - g.p[1]) - (g.p[1] - g.p[0])).norm() : 0.0;
+        g.p[0] = g.p[1];
+        g.p[1] = out.goal.p;
+        g.t_s = ctx.t_s;
+        g.samples = std::min(g.samples + 1, 2);
+      }
+    }
   }
   out.frame = out.goal * s.drive.at(r);
   // From rest onto a moving goal: the start stays where the arm stood, the end rides on the
@@ -247,6 +264,9 @@ bool TrajectoryGenerator::segment_value(const Segment& s, const SampleContext& c
   }
   return false;
 }
+
+/// A goal whose step changes by more than this in one sample has jumped (m).
+constexpr double kGoalJump_m = 2e-3;
 
 // --- Building segments
 // -----------------------------------------------------------------------------
@@ -1115,6 +1135,15 @@ void TrajectoryGenerator::start_waiting(const SampleContext& ctx, double t) {
     return;
   }
   const MotionRequest r = *waiting_;
+  if (cur_.kind == Segment::Kind::cartesian && cur_.resting) {
+    // Tracking the last motion's goal, which has just jumped (a varb given a new value right
+    // before this move()): start from where the arm stands, not from the goal's new place.
+    Pose p;
+    pose_at(cur_, ctx, 1.0, p);
+    if (goal_track_.position == cur_.position && goal_track_.jump_m > kGoalJump_m) {
+      rest_at(last_q_);
+    }
+  }
   // From rest: the transition begins now; the straight part tau later.
   if (!build(r, ctx, t)) return;
   waiting_.reset();
@@ -1254,7 +1283,15 @@ std::uint64_t TrajectoryGenerator::step(const SampleContext& ctx, const JointVec
       if (out || fast || jerky) {
         const std::uint64_t id = tr_.active && tr_.to_next ? next_.id : cur_.id;
         const int joint = static_cast<int>(j) + 1;
-        if (out) {
+        const Segment& owner = tr_.active && tr_.to_next ? next_ : cur_;
+        if (goal_track_.position == owner.position && goal_track_.jump_m > kGoalJump_m &&
+            owner.position != nullptr) {
+          fail(id, ctx, kin::IkStatus::ok, joint,
+               text("the goal of {} jumped {:.1f} mm in a sample at t = {:.3f} s, joint {} "
+                    "would follow too fast (a varb changed at once? Use hold, read at move(), "
+                    "or change it in small steps)",
+                    owner.position->name(), goal_track_.jump_m * 1e3, t, joint));
+        } else if (out) {
           fail(id, ctx, kin::IkStatus::joint_limits, joint,
                text("joint {} would leave its limits at t = {:.3f} s", joint, t));
         } else if (fast) {

@@ -390,6 +390,16 @@ class TrajectoryGenerator {
   bool pose_valid_ = false;
   math::Vec3 last_frame_p_;
   bool have_last_frame_ = false;
+  /// The present segment's goal at its last two samples, and how far its step changed at the
+  /// last, m: a goal that jumps (a varb transform set at once) is named as the cause when a
+  /// guard stops the arm. Kept by pose_at (const: a record of what the loop saw).
+  struct GoalTrack {
+    const Position* position = nullptr;
+    int samples = 0;
+    double t_s = 0.0, jump_m = 0.0;
+    math::Vec3 p[2];
+  };
+  mutable GoalTrack goal_track_;
 };
 
 }  // namespace rccx::rccl
