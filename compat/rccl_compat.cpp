@@ -213,7 +213,9 @@ void apply_settings(State& s) {
   s.arm->set_velocity(s.settings.translation_m_per_s, s.settings.rotation_rad_per_s);
   s.arm->set_segment_time(s.settings.segment_time_s);
   s.arm->set_transition_time(s.settings.transition_time_s);
-  if (s.configuration.empty()) {
+  // setconf() is for joint moves, which may change configuration; a Cartesian line keeps the
+  // arm's (the manual's setconf letters stay asked for the joint moves that follow).
+  if (s.configuration.empty() || s.settings.mode == rc::Mode::cartesian) {
     s.arm->set_configuration("");
   } else {
     const kin::Kinematics& k = s.arm->kinematics();
