@@ -298,6 +298,26 @@ TEST(RcclConfiguration, GoalOutsideThePresentConfigurationIsRefusedAtTheCall) {
 // transition (lengthened by the generator as the bounds need) and tracked: the measured tool
 // point (forward kinematics of the joints as read) against the part where the belt has it at
 // the time of that reading, once the arm has joined it.
+/// A conveyor along y in front of the PUMA 560, tool down (configuration ruf reaches all of
+/// it): PART = CONV START, CONV moving at speed_m_per_s from t0_s on (still until t0_s is set).
+struct Belt {
+  explicit Belt(double speed) : speed_m_per_s(speed) {}
+  double speed_m_per_s;
+  double t0_s = -1.0;
+  math::Transform start{math::Rot3::rot_x(180_deg), {0.45, -0.2, 0.0}};
+  [[nodiscard]] math::Transform at(double t) const {
+    const double dt = t0_s < 0.0 ? 0.0 : std::max(0.0, t - t0_s);
+    return math::Transform::translation(0.0, speed_m_per_s * dt, 0.0);
+  }
+  /// The part's position equation; it refers to this belt, which must outlive it.
+  [[nodiscard]] rccl::PositionPtr part() const {
+    const auto conv =
+        rccl::functional("CONV", [this](const rccl::SampleContext& ctx) { return at(ctx.t_s); });
+    const auto t6 = rccl::t6();
+    return rccl::Position::make("PART", {t6}, {conv, rccl::constant("START", start)}, t6);
+  }
+};
+
 // RCCL's stop(ms) after a motion onto a moving goal: the arm stays on that position for the
 // time, riding along with the conveyor (before, the dwell froze the joints and the belt left the
 // tool behind); the dwell ends on time and the next motion starts from the belt.
@@ -306,22 +326,14 @@ TEST(RcclGeneratorRobust, ADwellOnAMovingGoalKeepsTrackingIt) {
   rccl::Manipulator arm(*robot.session);
   const kin::Kinematics& kin = arm.kinematics();
   arm.start();
-  constexpr double kSpeed = 0.1;  // m/s along y
-  const math::Transform start{math::Rot3::rot_x(180_deg), {0.45, -0.2, 0.0}};
-  double t_belt0 = -1.0;
-  const auto belt_at = [&](double t) {
-    const double dt = t_belt0 < 0.0 ? 0.0 : std::max(0.0, t - t_belt0);
-    return math::Transform::translation(0.0, kSpeed * dt, 0.0);
-  };
-  const auto conv =
-      rccl::functional("CONV", [&](const rccl::SampleContext& ctx) { return belt_at(ctx.t_s); });
-  const auto t6 = rccl::t6();
-  const auto part = rccl::Position::make("PART", {t6}, {conv, rccl::constant("START", start)}, t6);
+  Belt belt(0.1);
+  const math::Transform& start = belt.start;
+  const auto part = belt.part();
   arm.set_configuration("ruf");
   ASSERT_EQ(arm.waitfor(arm.move(pose_position("OVER", start)).end()), rccl::WaitResult::reached);
   arm.set_configuration("");
   arm.set_mode(Mode::cartesian);
-  t_belt0 = robot.session->how().time_s;
+  belt.t0_s = robot.session->how().time_s;
   ASSERT_EQ(arm.waitfor(arm.move(part).end(), 5s), rccl::WaitResult::reached);
   const rccl::Motion dwell = arm.dwell(1.5);
   const double dwell_from = robot.session->how().time_s;
@@ -329,7 +341,7 @@ TEST(RcclGeneratorRobust, ADwellOnAMovingGoalKeepsTrackingIt) {
   while (!arm.happened(dwell.end())) {
     robot.session->wait_for(10ms);
     const rtc::How h = robot.session->how();
-    worst = std::max(worst, (kin.forward(h.q()).p - (belt_at(h.time_s) * start).p).norm());
+    worst = std::max(worst, (kin.forward(h.q()).p - (belt.at(h.time_s) * start).p).norm());
     ASSERT_LT(h.time_s - dwell_from, 3.0) << "the dwell did not end";
   }
   const double dwell_s = robot.session->how().time_s - dwell_from;
@@ -352,18 +364,9 @@ TEST(RcclGeneratorRobust, AConveyorAtHalfAMetreASecondIsJoinedAndTrackedWithin2m
   rccl::Manipulator arm(*robot.session);
   const kin::Kinematics& kin = arm.kinematics();
   arm.start();
-  constexpr double kSpeed = 0.5;  // m/s along y
-  // Along y in front of the arm, tool down: configuration ruf reaches all of it (rccx kin ik).
-  const math::Transform start{math::Rot3::rot_x(180_deg), {0.45, -0.2, 0.0}};
-  double t_belt0 = -1.0;  // the belt starts when the arm leaves rest
-  const auto belt_at = [&](double t) {
-    const double dt = t_belt0 < 0.0 ? 0.0 : std::max(0.0, t - t_belt0);
-    return math::Transform::translation(0.0, kSpeed * dt, 0.0);
-  };
-  const auto conv =
-      rccl::functional("CONV", [&](const rccl::SampleContext& ctx) { return belt_at(ctx.t_s); });
-  const auto t6 = rccl::t6();
-  const auto part = rccl::Position::make("PART", {t6}, {conv, rccl::constant("START", start)}, t6);
+  Belt belt(0.5);  // starts when the arm leaves rest
+  const math::Transform& start = belt.start;
+  const auto part = belt.part();
   arm.set_configuration("ruf");
   ASSERT_EQ(arm.waitfor(arm.move(pose_position("OVER", start)).end()), rccl::WaitResult::reached);
   arm.set_configuration("");
@@ -371,17 +374,17 @@ TEST(RcclGeneratorRobust, AConveyorAtHalfAMetreASecondIsJoinedAndTrackedWithin2m
   arm.set_mode(Mode::cartesian);
   arm.set_transition_time(0.1);
   arm.set_velocity(1.0, 2.0);
-  t_belt0 = robot.session->how().time_s;
+  belt.t0_s = robot.session->how().time_s;
   const rccl::Motion m = arm.move(part);
   ASSERT_EQ(arm.waitfor(m.end(), 5s), rccl::WaitResult::reached)
       << (arm.failures().empty() ? "" : arm.failures().back().message());
-  const double joined_s = robot.session->how().time_s - t_belt0;
+  const double joined_s = robot.session->how().time_s - belt.t0_s;
   double worst = 0.0;
   int samples = 0;
   for (; samples < 40; ++samples) {  // 0.4 s of tracking, 0.2 m of belt
     robot.session->wait_for(10ms);
     const rtc::How h = robot.session->how();
-    const math::Vec3 goal = (belt_at(h.time_s) * start).p;
+    const math::Vec3 goal = (belt.at(h.time_s) * start).p;
     worst = std::max(worst, (kin.forward(h.q()).p - goal).norm());
   }
   std::printf("joined the belt %.3f s after it started; tracked within %.2f mm over %d samples\n",
