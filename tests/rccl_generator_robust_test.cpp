@@ -49,6 +49,15 @@ Peaks peaks(const GeneratorRun& run) {
   return p;
 }
 
+/// Motion settings: the tool at 50 mm/s and `rotation_rad_per_s`.
+rccl::MotionSettings settings(Mode mode, double rotation_rad_per_s) {
+  rccl::MotionSettings s;
+  s.mode = mode;
+  s.translation_m_per_s = 0.05;
+  s.rotation_rad_per_s = rotation_rad_per_s;
+  return s;
+}
+
 // The issue's pick and place on the Microbo (28 ms): down onto the object and up again in
 // Cartesian mode, then a joint move that turns joint 6 by 236 deg queued straight after the
 // departure (the two blended), down and up at the place, park. Before: "joint 6 would move at
@@ -57,12 +66,8 @@ Peaks peaks(const GeneratorRun& run) {
 // program runs to its end, every sample within the bounds, and joint 6 does turn by 236 deg.
 TEST(RcclGeneratorRobust, MicroboWristTurnBlendedIntoACartesianDepartureStaysWithinBounds) {
   GeneratorRun run("microbo", 0.028);
-  rccl::MotionSettings cart;
-  cart.mode = Mode::cartesian;
-  cart.translation_m_per_s = 0.05;
-  cart.rotation_rad_per_s = 2.0;
-  rccl::MotionSettings joint = cart;
-  joint.mode = Mode::joint;
+  const rccl::MotionSettings cart = settings(Mode::cartesian, 2.0);
+  rccl::MotionSettings joint = settings(Mode::joint, 2.0);
   joint.translation_m_per_s = 0.3;  // the joints' top speeds set the joint move's time
   const auto pose = [&](double q1, double d2, double d3, double q6) {
     return run.kinematics->forward(kin::JointVector{q1, d2, d3, 90_deg, -90_deg, q6});
@@ -115,12 +120,8 @@ TEST(RcclGeneratorRobust, MicroboWristTurnBlendedIntoACartesianDepartureStaysWit
 // says that joint mode turns it the other way, which then runs.
 TEST(RcclGeneratorRobust, ACartesianLinePastAMultiTurnJointsLimitIsRefusedNamingTheLimit) {
   GeneratorRun run("microbo", 0.028);
-  rccl::MotionSettings cart;
-  cart.mode = Mode::cartesian;
-  cart.translation_m_per_s = 0.05;
-  cart.rotation_rad_per_s = 1.0;
-  rccl::MotionSettings joint = cart;
-  joint.mode = Mode::joint;
+  const rccl::MotionSettings cart = settings(Mode::cartesian, 1.0);
+  const rccl::MotionSettings joint = settings(Mode::joint, 1.0);
   const auto q = [](double q6) { return kin::JointVector{0.3, 0.21, 0.35, 90_deg, -90_deg, q6}; };
   const auto start = run.move(rccl::Position::joints("START", q(-200_deg)), joint);
   ASSERT_TRUE(run.run_until_ended(start));
