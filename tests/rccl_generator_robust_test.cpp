@@ -213,7 +213,7 @@ TEST(RcclConfiguration, JointMoveGoesIntoTheConfigurationAskedFor) {
 // call in Cartesian mode, and in joint mode without set_configuration, naming a configuration
 // that can and how to switch; nothing is queued. set_configuration(that) then a joint move gets
 // there. A goal with a functional transform is checked at its present value the same way.
-TEST(RcclConfiguration, GoalOutsideThePresentConfigurationIsRefusedAtTheCall) {
+TEST(RcclConfiguration, GoalOutsideThePresentConfigurationIsRefusedAtTheCallOrJoinedInJointMode) {
   rtc::SimulatedRobot robot(kin::builtin_robot("puma560"));
   rccl::Manipulator arm(*robot.session);
   const kin::Kinematics& kin = arm.kinematics();
@@ -245,8 +245,10 @@ TEST(RcclConfiguration, GoalOutsideThePresentConfigurationIsRefusedAtTheCall) {
   ASSERT_FALSE(kin.inverse(goal, o));  // independently: not in the present configuration
   const std::uint64_t before = arm.last_queued();
   std::string message;
+  // A Cartesian line, and a joint move asked to stay in the present configuration: refused.
   for (const rccl::Mode m : {rccl::Mode::cartesian, rccl::Mode::joint}) {
     arm.set_mode(m);
+    arm.set_configuration(m == rccl::Mode::joint ? kin.configuration_name(present) : "");
     try {
       arm.move(at("ELSEWHERE", goal));
       FAIL() << "move() accepted a goal outside the present configuration";
@@ -257,6 +259,7 @@ TEST(RcclConfiguration, GoalOutsideThePresentConfigurationIsRefusedAtTheCall) {
     EXPECT_NE(message.find(kin.configuration_name(present)), std::string::npos) << message;
     EXPECT_NE(message.find("then move in joint mode"), std::string::npos) << message;
   }
+  arm.set_configuration("");
   EXPECT_EQ(arm.last_queued(), before);
   // The configuration it names reaches the goal: switch to it, in joint mode.
   const std::size_t q1 = message.find("set_configuration(\"") + 19;
@@ -290,6 +293,18 @@ TEST(RcclConfiguration, GoalOutsideThePresentConfigurationIsRefusedAtTheCall) {
   arm.set_mode(rccl::Mode::cartesian);
   EXPECT_NO_THROW(arm.move(at("AGAIN", goal)));
   EXPECT_EQ(arm.waitfor(arm.completed()), rccl::WaitResult::reached);
+  // Back to park, then a joint move with no configuration asked: the present one cannot reach
+  // the goal, so the move takes one that can (the nearest), as a manual program expects.
+  arm.set_mode(rccl::Mode::joint);
+  ASSERT_EQ(arm.waitfor(arm.move(arm.park()).end()), rccl::WaitResult::reached);
+  ASSERT_EQ(kin.configuration_of(robot.session->how().q()), present);
+  ASSERT_EQ(arm.waitfor(arm.move(at("AUTO", goal)).end()), rccl::WaitResult::reached)
+      << (arm.failures().empty() ? "" : arm.failures().back().message());
+  robot.session->wait_for(300ms);
+  const kin::JointVector q_auto = robot.session->how().q();
+  EXPECT_NE(kin.configuration_of(q_auto), present);
+  EXPECT_LT((kin.forward(q_auto).p - goal.p).norm(), 1e-3);
+  EXPECT_TRUE(arm.failures().empty());
   EXPECT_FALSE(arm.stop_control().ended());
 }
 

@@ -141,7 +141,7 @@ void Manipulator::set_configuration(std::string_view name) {
   settings_.configuration = c->index;
 }
 
-void Manipulator::check_reachable(const Position& p) {
+std::int16_t Manipulator::check_reachable(const Position& p) {
   if (p.in_joints()) {
     const kin::JointVector& q = p.joint_values();
     if (q.size() != kinematics_->dof()) {
@@ -159,7 +159,7 @@ void Manipulator::check_reachable(const Position& p) {
     }
     planned_configuration();
     queued_configuration_ = kinematics_->configuration_of(q);
-    return;
+    return -1;
   }
   const auto names = kinematics_->configuration_names();
   const rtc::How h = session_.how();
@@ -172,7 +172,7 @@ void Manipulator::check_reachable(const Position& p) {
       throw MotionError(fmt::format("position {} cannot be reached{}: {}", p.name(), when,
                                     kin::describe(r.status)));
     }
-    return;
+    return -1;
   }
   const bool asked = settings_.configuration >= 0 && settings_.mode == Mode::joint;
   const kin::Configuration present = planned_configuration();
@@ -191,11 +191,31 @@ void Manipulator::check_reachable(const Position& p) {
   const kin::IkResult r = kinematics_->inverse(t6, o);
   if (r) {
     queued_configuration_ = c;
-    return;
+    return -1;
+  }
+  const kin::IkSolutions all = kinematics_->inverse_all(t6);
+  if (!asked && settings_.mode == Mode::joint && all.count > 0) {
+    // A joint move may change configuration: none asked, and the present one cannot reach
+    // the goal, so take the configuration whose solution lies nearest the arm's joints (as a
+    // program written for another arm's park pose expects, e.g. the PUMA's wrist flipped).
+    const kin::JointVector here = session_.how().q();
+    const kin::IkResult* best = nullptr;
+    double best_d = 0.0;
+    for (const kin::IkResult& s : all.solutions()) {
+      double d = 0.0;
+      for (std::size_t j = 0; j < here.size() && j < s.q.size(); ++j) {
+        d += (s.q[j] - here[j]) * (s.q[j] - here[j]);
+      }
+      if (best == nullptr || d < best_d) {
+        best = &s;
+        best_d = d;
+      }
+    }
+    queued_configuration_ = best->configuration;
+    return static_cast<std::int16_t>(best->configuration.index);
   }
   std::string others;
   std::string first;
-  const kin::IkSolutions all = kinematics_->inverse_all(t6);
   for (const kin::IkResult& s : all.solutions()) {
     const std::string_view n = kinematics_->configuration_name(s.configuration);
     others += others.empty() ? "" : ", ";
@@ -222,11 +242,13 @@ kin::Configuration Manipulator::planned_configuration() {
   return queued_configuration_;
 }
 
-Motion Manipulator::submit(MotionRequest r, const PositionPtr& keep, const StartWhen& when) {
+Motion Manipulator::submit(MotionRequest r, const PositionPtr& keep, const StartWhen& when,
+                           std::int16_t configuration) {
   if (!started_) throw MotionError("call start() (rccl_control) before queuing motions");
   if (zero_gravity_) throw MotionError("zero gravity is on: set_zero_gravity(false) first");
   r.id = next_id_;
   r.settings = settings_;
+  if (configuration >= 0) r.settings.configuration = configuration;
   if (when.after.size() > StartWhen::kMaxGates) {
     throw MotionError(
         fmt::format("a motion waits for at most {} events (got {}); wait for the "
@@ -271,11 +293,11 @@ Motion Manipulator::submit(MotionRequest r, const PositionPtr& keep, const Start
 
 Motion Manipulator::move(const PositionPtr& position, const StartWhen& when) {
   if (!position) throw MotionError("move(): the position is null");
-  check_reachable(*position);
+  const std::int16_t configuration = check_reachable(*position);
   MotionRequest r;
   r.kind = RequestKind::move;
   r.position = position.get();
-  return submit(r, position, when);
+  return submit(r, position, when, configuration);
 }
 
 Motion Manipulator::dwell(double seconds, const StartWhen& when) {

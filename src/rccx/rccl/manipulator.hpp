@@ -92,6 +92,8 @@ class Manipulator {
   /// when it cannot be reached within limits in the configuration the motion will use - the
   /// one asked for with set_configuration() in joint mode, else the one the arm will be in when
   /// the motion starts (a Cartesian line keeps it) - saying which configurations do reach it.
+  /// A joint move with no configuration asked whose goal the present configuration cannot
+  /// reach moves into the configuration whose solution lies nearest the arm's joints.
   /// `when`: the motion starts only once those events (other robots' motions, see
   /// cell::Cell::event) have happened, or with the others of a rendezvous; it then starts from rest
   /// (the motion before it comes to rest first unless its gates are open by then) and is cancelled
@@ -147,9 +149,13 @@ class Manipulator {
   [[nodiscard]] TrajectoryGenerator& generator() noexcept { return *generator_; }
 
  private:
-  Motion submit(MotionRequest r, const PositionPtr& keep, const StartWhen& when);
+  /// `configuration` >= 0: the configuration this motion moves into (chosen for it).
+  Motion submit(MotionRequest r, const PositionPtr& keep, const StartWhen& when,
+                std::int16_t configuration = -1);
   void drain();
-  void check_reachable(const Position& p);
+  /// Refuses (MotionError) a goal the motion cannot reach. Returns the configuration a joint
+  /// move with none asked must take (the present one cannot reach the goal), else -1.
+  std::int16_t check_reachable(const Position& p);
   /// The configuration the arm will be in once the queued motions have run.
   kin::Configuration planned_configuration();
 
