@@ -2,6 +2,7 @@
 # exits 0 (each program checks the geometry it asked for and exits 1 when it is off), prints
 # what EXPECT matches, and logged samples.
 #   cmake -DPROG=path -DLOG=out.csv -DEXPECT=regex [-DINPUT=file] [-DDB=file] [-DFRESH_DB=ON]
+#         [-DROBOT=name (RCCX_ROBOT)]
 #         -P c_example_test.cmake
 foreach(var PROG LOG EXPECT)
   if(NOT DEFINED ${var})
@@ -10,6 +11,9 @@ foreach(var PROG LOG EXPECT)
 endforeach()
 file(REMOVE "${LOG}")
 set(ENV{RCCX_LOG} "${LOG}")
+if(DEFINED ROBOT)
+  set(ENV{RCCX_ROBOT} "${ROBOT}")
+endif()
 if(DEFINED DB)
   if(FRESH_DB)
     file(REMOVE "${DB}")
