@@ -193,27 +193,18 @@ std::int16_t Manipulator::check_reachable(const Position& p) {
     queued_configuration_ = c;
     return -1;
   }
-  const kin::IkSolutions all = kinematics_->inverse_all(t6);
-  if (!asked && settings_.mode == Mode::joint && all.count > 0) {
+  if (!asked && settings_.mode == Mode::joint) {
     // A joint move may change configuration: none asked, and the present one cannot reach
     // the goal, so take the configuration whose solution lies nearest the arm's joints (as a
     // program written for another arm's park pose expects, e.g. the PUMA's wrist flipped).
-    const kin::JointVector here = session_.how().q();
-    const kin::IkResult* best = nullptr;
-    double best_d = 0.0;
-    for (const kin::IkResult& s : all.solutions()) {
-      double d = 0.0;
-      for (std::size_t j = 0; j < here.size() && j < s.q.size(); ++j) {
-        d += (s.q[j] - here[j]) * (s.q[j] - here[j]);
-      }
-      if (best == nullptr || d < best_d) {
-        best = &s;
-        best_d = d;
-      }
+    kin::IkOptions nearest;
+    nearest.near = session_.how().q();
+    if (const kin::IkResult n = kinematics_->inverse(t6, nearest)) {
+      queued_configuration_ = n.configuration;
+      return static_cast<std::int16_t>(n.configuration.index);
     }
-    queued_configuration_ = best->configuration;
-    return static_cast<std::int16_t>(best->configuration.index);
   }
+  const kin::IkSolutions all = kinematics_->inverse_all(t6);
   std::string others;
   std::string first;
   for (const kin::IkResult& s : all.solutions()) {

@@ -5,8 +5,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <numbers>
 
+#include "rccx/math/units.hpp"
 #include "rccx/rccl/paul_transition.hpp"
 #include "rccx/rtc/types.hpp"
 
@@ -411,7 +411,7 @@ bool TrajectoryGenerator::build(const MotionRequest& r, const SampleContext& ctx
              text("the straight line to {} turns joint {} past its limit ({:.1f} {}) about "
                   "{:.0f}% of the way (the line takes the shorter way round); move in joint "
                   "mode, which turns it the other way, or add a via point",
-                  name, jumping, revolute ? limit * 180.0 / std::numbers::pi : limit * 1000.0,
+                  name, jumping, revolute ? math::rad_to_deg(limit) : limit * 1000.0,
                   revolute ? "deg" : "mm", 100.0 * (k - 0.5) / kChecks));
         return false;
       }
@@ -1138,6 +1138,7 @@ void TrajectoryGenerator::start_waiting(const SampleContext& ctx, double t) {
   if (cur_.kind == Segment::Kind::cartesian && cur_.resting) {
     // Tracking the last motion's goal, which has just jumped (a varb given a new value right
     // before this move()): start from where the arm stands, not from the goal's new place.
+    // (Evaluating the goal for this sample is what records its step in goal_track_.)
     Pose p;
     pose_at(cur_, ctx, 1.0, p);
     if (goal_track_.position == cur_.position && goal_track_.jump_m > kGoalJump_m) {
