@@ -16,6 +16,7 @@
 
 #include "rccx/kinematics/joint_vector.hpp"
 #include "rccx/kinematics/robot_model.hpp"
+#include "rccx/math/wrench.hpp"
 
 namespace rccx::hw {
 
@@ -106,6 +107,16 @@ class SimulatedArm {
   /// The plant's true state, not through encoders: for tests and the viewer.
   [[nodiscard]] virtual kin::JointVector true_position() const noexcept = 0;
   [[nodiscard]] virtual kin::JointVector true_velocity() const noexcept = 0;
+
+  /// The true load on the wrist, as an ideal six-axis sensor mounted at the flange would feel
+  /// it: the wrench the tool side (the tool's weight and whatever touches it) exerts on the
+  /// arm, about T6's origin in T6's axes (N, N m), where T6 is the kinematic model's last frame.
+  /// False, and `w` untouched, when this arm has no sensor (no contact model): only a plant
+  /// with contact (MujocoArm) has one. Called by the communication task every sample.
+  [[nodiscard]] virtual bool wrist_wrench(math::Wrench& w) const noexcept {
+    (void)w;
+    return false;
+  }
 };
 
 /// The simulated arm for a model: a SimulatedPuma (simulated_puma.hpp: joint PID servos on a
