@@ -124,7 +124,8 @@ const char* rtc_error_name(int code);
 #define RTC_CHECK_TGT_POS 2 /* a target outside the limits, not sent (RTC_TERM_TARGET_POSITION) */
 #define RTC_CHECK_OBS_VEL 4 /* a joint measured above its top speed (RTC_TERM_OBSERVED_VELOCITY) */
 #define RTC_CHECK_TGT_VEL 8 /* a commanded speed above the top speed (RTC_TERM_TARGET_VELOCITY) */
-#define RTC_CHECK_ALL 15
+#define RTC_CHECK_FORCE 16 /* a wrist force sensor saturated or frozen (RTC_TERM_FORCE_...) */
+#define RTC_CHECK_ALL 31
 
 /* how.flags[j] bits (how.allflags: every joint's or-ed together). */
 #define RTC_F_CALIBRATED 0x001       /* positions are absolute */
@@ -159,6 +160,8 @@ const char* rtc_error_name(int code);
 #define RTC_TERM_POWER_FAILURE 32       /* arm power lost, or it could not be turned on */
 #define RTC_TERM_PHASE_ERROR 33         /* an encoder phase error */
 #define RTC_TERM_JOINT_FAULT 34         /* a joint's controller reported a fault */
+#define RTC_TERM_FORCE_SATURATED 40     /* the wrist force sensor reached its range */
+#define RTC_TERM_FORCE_FROZEN 41        /* the wrist force sensor stopped sending readings */
 
 /* The state of the arm, written by the library each sample before fn1. Range values are zero
    at the joint's lower limit and grow to its range (thesis 4.5.4.1): rad for revolute joints,

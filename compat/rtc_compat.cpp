@@ -62,10 +62,13 @@ static_assert(RTC_TERM_ENCODER_ERROR == static_cast<int>(rtc::TerminateCode::enc
 static_assert(RTC_TERM_POWER_FAILURE == static_cast<int>(rtc::TerminateCode::power_failure));
 static_assert(RTC_TERM_PHASE_ERROR == static_cast<int>(rtc::TerminateCode::phase_error));
 static_assert(RTC_TERM_JOINT_FAULT == static_cast<int>(rtc::TerminateCode::joint_fault));
+static_assert(RTC_TERM_FORCE_SATURATED == static_cast<int>(rtc::TerminateCode::force_saturated));
+static_assert(RTC_TERM_FORCE_FROZEN == static_cast<int>(rtc::TerminateCode::force_frozen));
 static_assert(RTC_F_CALIBRATED == rtc::kCalibrated && RTC_F_JOINT_FAULT == rtc::kJointFault &&
               RTC_F_TGT_POS_OUT == rtc::kTargetPositionOut);
 static_assert(RTC_CHECK_OBS_POS == rtc::kCheckObservedPosition &&
-              RTC_CHECK_TGT_VEL == rtc::kCheckTargetVelocity && RTC_CHECK_ALL == rtc::kCheckAll);
+              RTC_CHECK_TGT_VEL == rtc::kCheckTargetVelocity &&
+              RTC_CHECK_FORCE == rtc::kCheckForce && RTC_CHECK_ALL == rtc::kCheckAll);
 
 /// The one RTC session of a C program.
 struct Rtc {

@@ -45,8 +45,7 @@ struct Wrench {
 /// wrench about s's origin in s's axes, when s's orientation in the world is `world_from_s_R`
 /// and gravity points along world -z at `g_m_per_s2`.
 [[nodiscard]] constexpr Wrench weight_wrench(const Rot3& world_from_s_R, double mass_kg,
-                                             const Vec3& com_m,
-                                             double g_m_per_s2 = 9.81) noexcept {
+                                             const Vec3& com_m, double g_m_per_s2 = 9.81) noexcept {
   const Vec3 f = world_from_s_R.transpose_times(Vec3{0.0, 0.0, -mass_kg * g_m_per_s2});
   return {f, cross(com_m, f)};
 }

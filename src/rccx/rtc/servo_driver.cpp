@@ -2,7 +2,17 @@
 
 namespace rccx::rtc {
 
-ServoDriver::ServoDriver(hw::SimulatedArm& arm) noexcept : arm_(arm) {}
+ServoDriver::ServoDriver(hw::SimulatedArm& arm) : arm_(arm) {
+  math::Wrench probe;
+  if (arm.wrist_wrench(probe)) force_sensor_.emplace(arm);
+}
+
+bool ServoDriver::set_force_sensor_spec(const hw::ForceSensorSpec& spec) {
+  if (!force_sensor_) return false;
+  force_sensor_.emplace(arm_, spec);
+  force_stale_ = 0;
+  return true;
+}
 
 void ServoDriver::read(double t_s, How& how) noexcept {
   arm_.advance_to(t_s);
@@ -37,6 +47,16 @@ void ServoDriver::read(double t_s, How& how) noexcept {
   how.power = arm_.power();
   how.hand_closed = arm_.hand_closed();
   how.outputs = arm_.outputs();
+
+  if (force_sensor_) {
+    const hw::ForceReading r = force_sensor_->read();
+    force_stale_ = r.sequence == how.force.sequence && how.force.present ? force_stale_ + 1 : 0;
+    how.force.present = true;
+    how.force.wrench = r.wrench;
+    how.force.sequence = r.sequence;
+    how.force.saturated = r.saturated;
+    how.force.frozen = force_stale_ >= kForceFrozenSamples;
+  }
 }
 
 void ServoDriver::send(const JointCommands& commands) noexcept {

@@ -937,6 +937,26 @@ bool Session::controlled_cycle(CommState& c, std::uint32_t k) noexcept {
     }
   }
 
+  // The wrist sensor: a reading at its range or one that no longer changes means nothing.
+  if (h.force.present && (c.chg.checking & kCheckForce) != 0) {
+    if (h.force.frozen) {
+      std::array<char, kMessageCapacity> d;
+      format_text(d, "the wrist sensor's reading {} repeated for {} samples", h.force.sequence,
+                  kForceFrozenSamples);
+      end_control(c, TerminateCode::force_frozen, 0, d.data());
+      return false;
+    }
+    if (h.force.saturated) {
+      const math::Wrench& w = h.force.wrench;
+      std::array<char, kMessageCapacity> d;
+      format_text(d, "wrist force ({:.1f}, {:.1f}, {:.1f}) N, torque ({:.2f}, {:.2f}, {:.2f}) N m",
+                  w.force_N.x, w.force_N.y, w.force_N.z, w.torque_N_m.x, w.torque_N_m.y,
+                  w.torque_N_m.z);
+      end_control(c, TerminateCode::force_saturated, 0, d.data());
+      return false;
+    }
+  }
+
   // Observed limits.
   for (std::size_t i = 0; i < h.dof; ++i) {
     JointHow& j = h.joint[i];

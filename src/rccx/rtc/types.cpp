@@ -102,6 +102,11 @@ constexpr CodeInfo kCodes[] = {
      "a joint's encoder reported a phase error (both channels switched at once)"},
     {TerminateCode::joint_fault, "joint_fault",
      "a joint controller reported a fault during motion (following error or overheating)"},
+    {TerminateCode::force_saturated, "force_saturated",
+     "the wrist force sensor reached its measuring range: the arm pushed too hard; lower the "
+     "force asked or the speed of approach"},
+    {TerminateCode::force_frozen, "force_frozen",
+     "the wrist force sensor stopped sending new readings: check its cable and power"},
 };
 
 const CodeInfo* info(TerminateCode code) noexcept {

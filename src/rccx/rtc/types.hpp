@@ -11,6 +11,7 @@
 #include <string_view>
 
 #include "rccx/kinematics/joint_vector.hpp"
+#include "rccx/math/wrench.hpp"
 
 namespace rccx::rtc {
 
@@ -39,7 +40,8 @@ enum Check : std::uint8_t {
   kCheckTargetPosition = 1U << 1,    ///< a target outside the limits ends the session
   kCheckObservedVelocity = 1U << 2,  ///< a measured speed above the joint's maximum ends it
   kCheckTargetVelocity = 1U << 3,    ///< a commanded speed above the joint's maximum ends it
-  kCheckAll = 0x0f,
+  kCheckForce = 1U << 4,  ///< a wrist force sensor that saturates or freezes ends the session
+  kCheckAll = 0x1f,
 };
 
 enum class Request : std::uint8_t { none, on, off };
@@ -119,6 +121,23 @@ struct JointHow {
   [[nodiscard]] bool has(JointFlag f) const noexcept { return (flags & f) != 0; }
 };
 
+/// The wrist force/torque sensor as the communication task read it this sample (thesis 4.4.2:
+/// a six-axis sensor at the flange whose readings a force transform carries to the tool).
+struct ForceHow {
+  bool present = false;  ///< this robot has a wrist sensor; the rest means nothing otherwise
+  /// The reading as the sensor reports it: the load the tool side puts on the wrist (the
+  /// tool's weight, contacts) plus the sensor's bias and noise, about T6's origin in T6's axes
+  /// (N, N m). Gravity compensation and the force transform to the tool are the reader's
+  /// (rccx::force).
+  math::Wrench wrench;
+  std::uint32_t sequence = 0;  ///< the sensor's own reading counter: it advances every reading
+  bool saturated = false;      ///< an axis stood at its measuring range this sample
+  /// The counter has not advanced for kForceFrozenSamples samples: the reading is stale.
+  bool frozen = false;
+};
+/// A force sensor whose reading counter stands still this many samples in a row is frozen.
+inline constexpr std::uint32_t kForceFrozenSamples = 3;
+
 /// The state of the arm, as read by the communication task at the start of a sample.
 struct How {
   std::uint64_t sample = 0;  ///< sample number since the session was opened (first is 1)
@@ -133,6 +152,7 @@ struct How {
   /// holds them; examined_joint is 0-based, -1 before any.
   std::int8_t examined_joint = -1;
   std::array<std::uint8_t, 16> motor_parameters{};
+  ForceHow force;  ///< the wrist sensor, when the robot has one
 
   [[nodiscard]] JointVector q() const noexcept;
   [[nodiscard]] JointVector range() const noexcept;
@@ -158,6 +178,8 @@ enum class TerminateCode : std::int32_t {
   power_failure = 32,        ///< arm power was lost (or could not be turned on)
   phase_error = 33,          ///< a joint's encoder reported a phase error
   joint_fault = 34,          ///< a joint's controller reported a fault during motion
+  force_saturated = 40,      ///< the wrist force sensor reached its measuring range
+  force_frozen = 41,         ///< the wrist force sensor's readings stopped changing
 };
 
 /// What each code means, one line, for people.
