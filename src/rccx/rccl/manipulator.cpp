@@ -40,6 +40,7 @@ Manipulator::Manipulator(rtc::Session& session)
     : session_(session),
       kinematics_(kin::make_kinematics(session.driver().model())),
       generator_(std::make_unique<TrajectoryGenerator>(*kinematics_, generator_options(session))),
+      force_(*kinematics_),
       lower_(kinematics_->model().lower()),
       park_(Position::joints("park", kinematics_->model().ready())) {
   generator_->set_robot_name(kinematics_->model().name);
@@ -64,6 +65,7 @@ void Manipulator::start() {
     const double t_set = h.time_s + 2.0 * c.period_s();
     if (first_sample_) {
       generator_->reset(measured, t_set);
+      force_.reset();
       first_sample_ = false;
     }
     if (const rtc::Request hand = hand_request_.exchange(rtc::Request::none);
@@ -87,6 +89,17 @@ void Manipulator::start() {
     const SampleContext ctx{t_set, h.sample, &h};
     kin::JointVector q;
     const std::uint64_t id = generator_->step(ctx, &measured, q);
+    switch (force_.step(h, id, generator_->running_settings(id), c.period_s(), q)) {
+      case ForceControl::Outcome::none:
+        break;
+      case ForceControl::Outcome::contact:
+        generator_->request_next();
+        break;
+      case ForceControl::Outcome::overload:
+      case ForceControl::Outcome::unreachable:
+        generator_->request_stop(std::string_view(force_.why().data()));
+        break;
+    }
     for (std::size_t j = 0; j < q.size(); ++j) c.chg().posvel(j, q[j] - lower_[j]);
     c.chg().segment = static_cast<std::int32_t>(id);
   });
@@ -284,11 +297,99 @@ Motion Manipulator::submit(MotionRequest r, const PositionPtr& keep, const Start
 
 Motion Manipulator::move(const PositionPtr& position, const StartWhen& when) {
   if (!position) throw MotionError("move(): the position is null");
+  if ((settings_.guard.on() || settings_.compliance.any()) && started_ &&
+      !session_.how().force.present) {
+    throw MotionError(fmt::format(
+        "a guarded or compliant motion needs a wrist force sensor, and this {} has none: "
+        "simulate it on the MuJoCo plant (\"plant\": \"mujoco\" in its robot file)",
+        kinematics_->model().name));
+  }
   const std::int16_t configuration = check_reachable(*position);
   MotionRequest r;
   r.kind = RequestKind::move;
   r.position = position.get();
-  return submit(r, position, when, configuration);
+  const math::Transform saved_tool = settings_.tool;
+  settings_.tool = position->in_joints() ? math::Transform{} : position->tool_now();
+  const Motion m = [&] {
+    try {
+      return submit(r, position, when, configuration);
+    } catch (...) {
+      settings_.tool = saved_tool;
+      throw;
+    }
+  }();
+  settings_.tool = saved_tool;
+  return m;
+}
+
+void Manipulator::set_guard(const ForceGuard& guard) {
+  if (guard.on()) {
+    if (!std::isfinite(guard.threshold) || guard.threshold == 0.0) {
+      throw MotionError(
+          fmt::format("a force guard's threshold must be finite and not 0 (N or "
+                      "N m), got {}",
+                      guard.threshold));
+    }
+    if (guard.kind == ForceGuard::Kind::along && guard.axis > 5) {
+      throw MotionError(
+          fmt::format("a force guard's axis is 0..5 (fx fy fz tx ty tz), got {}", guard.axis));
+    }
+    if (guard.kind == ForceGuard::Kind::magnitude && guard.threshold < 0.0) {
+      throw MotionError("a force guard on the magnitude needs a threshold > 0 N");
+    }
+  }
+  settings_.guard = guard;
+}
+
+void Manipulator::set_compliance(const Compliance& c) {
+  const auto positive = [](double x) { return std::isfinite(x) && x > 0.0; };
+  for (std::size_t i = 0; i < 6; ++i) {
+    const bool ok = std::isfinite(c.force[i]) && std::isfinite(c.stiffness[i]) &&
+                    c.stiffness[i] >= 0.0 && std::isfinite(c.damping[i]) && c.damping[i] >= 0.0;
+    if (!ok) {
+      throw MotionError(fmt::format(
+          "compliance on {}: the force must be finite, the stiffness and damping finite and "
+          ">= 0 (0: the default damping)",
+          kForceAxisNames[i]));
+    }
+  }
+  if (!positive(c.max_speed_m_per_s) || !positive(c.max_rotation_rad_per_s) ||
+      !positive(c.max_offset_m) || !positive(c.max_offset_rad) || !positive(c.max_force_N) ||
+      !positive(c.max_torque_N_m)) {
+    throw MotionError("compliance: its speed, offset and force limits must all be > 0");
+  }
+  if (c.axes > 0x3f) throw MotionError("compliance: the axes are bits 0..5 (fx .. tz)");
+  for (std::size_t i = 0; i < 3; ++i) {
+    if (c.compliant(i) && std::abs(c.force[i]) >= c.max_force_N) {
+      throw MotionError(fmt::format("compliance: {} {:.1f} N is beyond the force limit {:.1f} N",
+                                    kForceAxisNames[i], c.force[i], c.max_force_N));
+    }
+  }
+  settings_.compliance = c;
+}
+
+std::optional<Contact> Manipulator::contact(const Motion& m) const noexcept {
+  if (!happened(m.end())) return std::nullopt;
+  const Contact c = force_.contact(m.id);
+  if (c.motion != m.id) return std::nullopt;
+  return c;
+}
+
+void Manipulator::update_from_contact(const Motion& m, const TransformPtr& x,
+                                      const PositionPtr& position) {
+  const std::optional<Contact> c = contact(m);
+  if (!c) {
+    throw MotionError(
+        fmt::format("motion {} made no contact (its guard did not trip, or it "
+                    "has not ended): nothing to update",
+                    m.id));
+  }
+  if (!x || !position) throw MotionError("update_from_contact: a null transform or position");
+  try {
+    x->set(position->solve_for(*x, c->t6));
+  } catch (const std::exception& e) {
+    throw MotionError(e.what());
+  }
 }
 
 Motion Manipulator::dwell(double seconds, const StartWhen& when) {

@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "rccx/kinematics/kinematics.hpp"
+#include "rccx/rccl/force_control.hpp"
 #include "rccx/rccl/trajectory.hpp"
 #include "rccx/rtc/session.hpp"
 
@@ -85,6 +86,28 @@ class Manipulator {
   /// The configuration to reach the next goals in ("lun", "n" ...); empty keeps the present one.
   void set_configuration(std::string_view name);
   [[nodiscard]] const MotionSettings& settings() const noexcept { return settings_; }
+
+  // --- Force (a robot with a wrist sensor: How::force.present) --------------------------------
+  /// The motions queued from now on end, as nextmove ends them, when the force the tool exerts
+  /// passes the guard's threshold (ForceGuard: along a tool axis, or its magnitude); contact()
+  /// then says where. ForceGuard{} (kind none) turns it off. Throws MotionError for a bad
+  /// threshold or axis.
+  void set_guard(const ForceGuard& guard);
+  /// RCCL's comply / lock for the motions queued from now on: the compliant tool axes yield by
+  /// the admittance of `compliance`; Compliance{} locks them all again. Throws MotionError for
+  /// a setting out of range.
+  void set_compliance(const Compliance& compliance);
+  /// The tool's load for gravity compensation (force::ToolLoad: the sensor's bias, the tool's
+  /// mass and centre of mass in T6; tool_calibration.hpp measures it), and the robot base's
+  /// orientation in the world (gravity along world -z; identity: the base stands upright).
+  void set_tool_load(const force::ToolLoad& load) noexcept { force_.set_tool_load(load); }
+  void set_world_from_base(const math::Rot3& r) noexcept { force_.set_world_from_base(r); }
+  /// Where guarded motion `m` touched, once it has ended (nullopt when its guard did not trip).
+  [[nodiscard]] std::optional<Contact> contact(const Motion& m) const noexcept;
+  /// RCCL's update with the contact's T6: sets transform `x` of `position` (a hold or constant
+  /// one, not T6) to the value that makes the equation hold where motion `m` touched - the
+  /// world model learns where the surface is. Throws MotionError without a contact.
+  void update_from_contact(const Motion& m, const TransformPtr& x, const PositionPtr& position);
 
   // --- Motions ----------------------------------------------------------------------------------
   /// Queues a motion to `position` and returns at once. The goal is checked now (a position
@@ -162,6 +185,7 @@ class Manipulator {
   rtc::Session& session_;
   std::unique_ptr<kin::Kinematics> kinematics_;
   std::unique_ptr<TrajectoryGenerator> generator_;
+  ForceControl force_;  ///< the loop's force side (guards, compliance)
   kin::JointVector lower_;
   MotionSettings settings_;
   PositionPtr park_;

@@ -967,6 +967,13 @@ void TrajectoryGenerator::end_motion(const Segment& s, const SampleContext& ctx,
   ledger_.mark_ended(s.id);
 }
 
+const MotionSettings* TrajectoryGenerator::running_settings(std::uint64_t id) const noexcept {
+  if (id == 0) return nullptr;
+  if (cur_.id == id) return &cur_.settings;
+  if (has_next_ && next_.id == id) return &next_.settings;
+  return nullptr;
+}
+
 void TrajectoryGenerator::next_motion(const SampleContext& ctx) noexcept {
   const bool moving = tr_.active || (cur_.kind != Segment::Kind::rest && !cur_.resting);
   if (halt_.active || !moving) return;

@@ -57,6 +57,7 @@
 #include <string_view>
 
 #include "rccx/kinematics/kinematics.hpp"
+#include "rccx/rccl/force_settings.hpp"
 #include "rccx/rccl/position.hpp"
 #include "rccx/rccl/sync.hpp"
 
@@ -75,6 +76,12 @@ struct MotionSettings {
   /// Configuration to reach the goal in (an index of Kinematics::configuration_names()), or
   /// -1 to keep the one the arm is in.
   std::int16_t configuration = -1;
+  /// Force sensing (force_settings.hpp): end on contact, yield along tool axes.
+  ForceGuard guard;
+  Compliance compliance;
+  /// The motion's tool product TOOL (T6 to the tool frame F, m): the frame the guard's and
+  /// the compliance's axes are in. Set by Manipulator::move from the position.
+  math::Transform tool;
 };
 
 enum class RequestKind : std::uint8_t { move, dwell };
@@ -199,6 +206,8 @@ class TrajectoryGenerator {
   std::uint64_t step(const SampleContext& ctx, const kin::JointVector* measured,
                      kin::JointVector& q);
   [[nodiscard]] bool at_rest() const noexcept;
+  /// The settings of motion `id` while it runs (the id step() returned), else null.
+  [[nodiscard]] const MotionSettings* running_settings(std::uint64_t id) const noexcept;
   [[nodiscard]] const kin::Kinematics& kinematics() const noexcept { return kin_; }
   [[nodiscard]] const GeneratorOptions& options() const noexcept { return options_; }
 
