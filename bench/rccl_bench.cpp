@@ -47,6 +47,7 @@
 #include "rccx/kinematics/kinematics.hpp"
 #include "rccx/math/transform.hpp"
 #include "rccx/math/units.hpp"
+#include "rccx/rccl/force_control.hpp"
 #include "rccx/rccl/position.hpp"
 #include "rccx/rccl/trajectory.hpp"
 #include "rccx/rccl/transforms.hpp"
@@ -95,7 +96,13 @@ Line line_of(const std::string& robot) {
   return robot == "microbo" ? microbo_line() : puma_line();
 }
 
-enum class Case { joint, cartesian, cartesian_2_functional, cartesian_2_c_functional };
+enum class Case {
+  joint,
+  cartesian,
+  cartesian_2_functional,
+  cartesian_2_c_functional,
+  cartesian_compliant,
+};
 
 /// One robot, its generator and the motion it repeats; steps it sample by sample.
 class Rig {
@@ -134,6 +141,15 @@ class Rig {
     position_ = rccl::Position::make("GOAL", {t6}, {conv_, obj_, grasp_}, t6);
     settings_.mode = c == Case::joint ? rccl::Mode::joint : rccl::Mode::cartesian;
     settings_.translation_m_per_s = kToolSpeed;
+    if (c == Case::cartesian_compliant) {
+      // The tool's x yields (a spring of 1000 N/m) to a steady 2 N push: every sample moves
+      // the setpoint off the path (one FK and one IK more), as a compliant motion does.
+      settings_.compliance.axes = 1U << 0;
+      settings_.compliance.stiffness[0] = 1000.0;
+      how_.force.present = true;
+      how_.force.wrench.force_N = {-2.0, 0.0, 0.0};
+      force_ = std::make_unique<rccl::ForceControl>(*kin_);
+    }
     error_ = calibrate();
   }
   Rig(const Rig&) = delete;
@@ -165,6 +181,8 @@ class Rig {
   /// the motion.
   std::string check_window() {
     if (wrong_id_ != 0) return "a timed setpoint did not belong to the motion";
+    if (force_failures_ != 0) return "the compliance stopped the motion";
+    if (force_ && force_->offset()[0] == 0.0) return "the compliance did not move the setpoint";
     while (auto e = gen_.next_event()) {
       if (e->kind != rccl::EventKind::started) {
         return "motion " + std::to_string(e->id) + " " + std::string(rccl::to_string(e->kind)) +
@@ -181,6 +199,7 @@ class Rig {
  private:
   void start_motion() {
     gen_.reset(q_start_, 0.0);
+    if (force_) force_->reset();
     while (gen_.next_event()) {
     }
     q_ = measured_ = q_start_;
@@ -202,6 +221,15 @@ class Rig {
     how_.sample = ctx_.sample;
     ctx_.how = &how_;
     const std::uint64_t id = gen_.step(ctx_, &measured_, q_);
+    if (force_) {
+      // The push stays along T6's x (the sensor turns with it); the force side reads q here.
+      for (std::size_t j = 0; j < measured_.size(); ++j) how_.joint[j].q = measured_[j];
+      how_.dof = static_cast<std::uint8_t>(measured_.size());
+      if (force_->step(how_, id, gen_.running_settings(id), kPeriod, q_) !=
+          rccl::ForceControl::Outcome::none) {
+        ++force_failures_;
+      }
+    }
     measured_ = q_;  // an ideal arm: where it was told to be
     ++k_;
     return id;
@@ -258,6 +286,8 @@ class Rig {
   rccl::TransformPtr conv_, obj_, grasp_;
   rccl::PositionPtr position_;
   rccl::MotionSettings settings_;
+  std::unique_ptr<rccl::ForceControl> force_;  ///< cartesian_compliant only
+  std::size_t force_failures_ = 0;
   JointVector q_start_, q_, measured_;
   rccl::SampleContext ctx_;
   rtc::How how_;
@@ -324,6 +354,12 @@ void BM_SetpointCartesian2Functional(benchmark::State& state, const std::string&
 /// the price of the C calling convention and of mm in a TRSF.
 void BM_SetpointCartesian2CFunctional(benchmark::State& state, const std::string& robot) {
   run_setpoint(state, robot, Case::cartesian_2_c_functional);
+}
+/// The Cartesian sample with compliance on along the tool's x (issue 15): the generator's step
+/// and the force side's (gravity compensation, force transform, admittance, the offset
+/// setpoint's FK and IK), beside BM_SetpointCartesian.
+void BM_SetpointCartesianCompliant(benchmark::State& state, const std::string& robot) {
+  run_setpoint(state, robot, Case::cartesian_compliant);
 }
 
 // ---- the peer: one Cartesian sample with Orocos KDL, PUMA 560 -----------------------------
@@ -474,9 +510,11 @@ BENCHMARK_CAPTURE(BM_SetpointJoint, microbo, std::string("microbo"));
 BENCHMARK_CAPTURE(BM_SetpointCartesian, microbo, std::string("microbo"));
 BENCHMARK_CAPTURE(BM_SetpointCartesian2Functional, microbo, std::string("microbo"));
 BENCHMARK_CAPTURE(BM_SetpointCartesian2CFunctional, microbo, std::string("microbo"));
+BENCHMARK_CAPTURE(BM_SetpointCartesianCompliant, microbo, std::string("microbo"));
 BENCHMARK_CAPTURE(BM_SetpointJoint, puma560, std::string("puma560"));
 BENCHMARK_CAPTURE(BM_SetpointCartesian, puma560, std::string("puma560"));
 BENCHMARK_CAPTURE(BM_SetpointCartesian2Functional, puma560, std::string("puma560"));
 BENCHMARK_CAPTURE(BM_SetpointCartesian2CFunctional, puma560, std::string("puma560"));
+BENCHMARK_CAPTURE(BM_SetpointCartesianCompliant, puma560, std::string("puma560"));
 BENCHMARK_CAPTURE(BM_PeerKdlCartesianSample, lma, KdlIk::lma);
 BENCHMARK_CAPTURE(BM_PeerKdlCartesianSample, nr_jl, KdlIk::nr_jl);

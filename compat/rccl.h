@@ -476,15 +476,47 @@ TRSF_PTR update(TRSF_PTR trans, POS_PTR pos);
  */
 int teach(TRSF_PTR trans, POS_PTR pos);
 
-/* --- Force: not yet --------------------------------------------------------------------------- */
+/* --- Force: guards and compliance (a robot with a wrist force sensor) ---------------------- */
+/*
+ * What the Microbo port had to leave out (thesis 4.4.2), on a robot whose simulated plant has
+ * a wrist force/torque sensor (the MuJoCo plant: "plant": "mujoco" in its robot file; others
+ * refuse these motions at move(), with a message that says so). Axes are those of the motion's tool
+ * frame (T6 TOOL, TOOL from makeposition's TL): fx fy fz in N, tx ty tz in N m, and a force is
+ * the one the tool exerts on what it touches (pressing the tool's z onto a table: fz > 0).
+ * Like setvel, each call applies to the motions queued after it.
+ */
 
 /**
- * comply / lock: compliance along tool axes (the manual's force control). Declared so that
- * programs that use them compile; in this version they change nothing and return
- * RTC_E_NOT_YET with a message (rccx gains force sensing on a simulated plant later).
+ * comply: the axes named yield, each holding the force that follows it among the arguments
+ * (double, N or N m): comply("fz", 5.) presses with 5 N along the tool's z; comply("fx fy",
+ * 0., 0.) lets a push move the tool in x and y. Returns 0 or RTC_E_ARGUMENT (nothing changed).
  */
 int comply(const char* what, ...);
+/** lock: the axes named follow the path again (lock("fz"), lock("all")). */
 int lock(const char* what);
+/**
+ * limit: the motions queued from now on end, as nextmove ends them (smoothly, where the arm
+ * is; POS.code RCCL_ONF), when the tool exerts the force that follows the axis among the
+ * arguments: limit("fz", 8.); limit("f", 10.): the force's magnitude. limit("off") removes it.
+ * One axis at a time. Returns 0 or RTC_E_ARGUMENT.
+ */
+int limit(const char* what, ...);
+#define RCCL_ONF 2 /* POS.code: ended on force, by a limit() guard */
+/**
+ * setload: the tool's mass (kg) and centre of mass (mm, in T6) for gravity compensation of
+ * the wrist sensor's readings. Returns 0, RTC_E_ARGUMENT or RTC_E_SEQUENCE (no session).
+ */
+int setload(double kg, double x, double y, double z);
+/**
+ * getcontact: YES when the last motion to pos that ended stopped on force; `at` (may be 0) gets
+ * the tool frame where the contact began (mm). NO otherwise.
+ */
+int getcontact(POS_PTR pos, TRSF_PTR at);
+/**
+ * updatecontact: update() with T6 where the last motion to pos touched (the world model learns
+ * where the surface is): sets trans and returns it, or 0 (no contact: RTC_E_SEQUENCE).
+ */
+TRSF_PTR updatecontact(TRSF_PTR trans, POS_PTR pos);
 
 /* --- Several robots: a workcell (Multi-RCCL style) ------------------------------------------- */
 /*

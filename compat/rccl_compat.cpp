@@ -7,6 +7,7 @@
 // the positions each move() built and the generator's events), `completed` (every queued
 // motion ended) and t6's value, refreshed by every call and after every sample waitfor() lets
 // run. Transforms are in rccl_transforms.cpp and rccl_algebra.cpp, the cell in rccl_cell.cpp.
+#include <algorithm>
 #include <atomic>
 #include <cctype>
 #include <chrono>
@@ -213,6 +214,8 @@ void apply_settings(State& s) {
   s.arm->set_velocity(s.settings.translation_m_per_s, s.settings.rotation_rad_per_s);
   s.arm->set_segment_time(s.settings.segment_time_s);
   s.arm->set_transition_time(s.settings.transition_time_s);
+  s.arm->set_guard(s.settings.guard);
+  s.arm->set_compliance(s.settings.compliance);
   // setconf() is for joint moves, which may change configuration; a Cartesian line keeps the
   // arm's (the manual's setconf letters stay asked for the joint moves that follow).
   if (s.configuration.empty() || s.settings.mode == rc::Mode::cartesian) {
@@ -392,7 +395,11 @@ void report_failures() {
     const auto it = s.motion_boxes.find(e.id);
     if (it == s.motion_boxes.end()) continue;
     if (e.kind == rc::EventKind::ended) {
-      it->second->shown->code = e.message() == rc::kNextmoveText ? RCCL_NEXTMOVE : 0;
+      int code = 0;
+      if (e.message() == rc::kNextmoveText) {
+        code = s.arm->contact(rc::Motion{e.id}) ? RCCL_ONF : RCCL_NEXTMOVE;
+      }
+      it->second->shown->code = code;
     } else if (e.kind == rc::EventKind::failed || e.kind == rc::EventKind::cancelled) {
       it->second->shown->code = RTC_E_MOTION;
     }
@@ -882,37 +889,59 @@ int rccl_wait_sample(void) {
   });
 }
 
-TRSF_PTR update(TRSF_PTR trans, POS_PTR pos) {
+namespace {
+/// update() and updatecontact(): trans solved for pos's equation with T6 = `t6`, or the
+/// measured T6 when there is none.
+TRSF_PTR solve_update(const char* call, TRSF_PTR trans, POS_PTR pos,
+                      const std::optional<math::Transform>& t6) {
   TRSF_PTR out = nullptr;
-  guarded("update", Say::print, RTC_E_ARGUMENT, [&] {
+  guarded(call, Say::print, RTC_E_ARGUMENT, [&] {
     State& s = state();
-    PositionBox* box = position_of(pos, "update");
+    PositionBox* box = position_of(pos, call);
     if (box == nullptr) return rtc_error;
     TrsfBox* x = box_of(trans);
     if (x == nullptr || x == &t6_box()) {
       return fail(RTC_E_ARGUMENT,
-                  fmt::format("update(..., {}): the transform to solve for must be one of the "
+                  fmt::format("{}(..., {}): the transform to solve for must be one of the "
                               "equation's, made by newtrans or gentr_, not t6",
-                              box->name),
+                              call, box->name),
                   Say::print);
     }
     if (!s.arm) {
-      return fail(RTC_E_SEQUENCE, "update: call rccl_open() first (T6 is read from the arm)",
+      return fail(RTC_E_SEQUENCE,
+                  fmt::format("{}: call rccl_open() first (T6 is read from the arm)", call),
                   Say::print);
     }
     rc::TransformPtr xt;
     const rc::PositionPtr p = build_position(*box, math::Transform::identity(), trans, &xt);
     if (!xt) {
       return fail(RTC_E_ARGUMENT,
-                  fmt::format("update({}, {}): {} is not in the equation {}", x->name, box->name,
+                  fmt::format("{}({}, {}): {} is not in the equation {}", call, x->name, box->name,
                               x->name, p->describe()),
                   Say::print);
     }
-    to_c(p->solve_for(*xt, measured_t6(s)), *trans);
+    to_c(p->solve_for(*xt, t6 ? *t6 : measured_t6(s)), *trans);
     out = trans;
     return RTC_OK;
   });
   return out;
+}
+
+/// The contact of the last motion to `box` that ended, if its guard tripped.
+std::optional<rc::Contact> last_contact(State& s, const PositionBox* box) {
+  if (!s.arm) return std::nullopt;
+  for (auto it = s.motion_boxes.rbegin(); it != s.motion_boxes.rend(); ++it) {
+    if (it->second != box) continue;
+    const rc::Motion m{it->first};
+    if (!s.arm->happened(m.end())) continue;
+    return s.arm->contact(m);
+  }
+  return std::nullopt;
+}
+}  // namespace
+
+TRSF_PTR update(TRSF_PTR trans, POS_PTR pos) {
+  return solve_update("update", trans, pos, std::nullopt);
 }
 
 int teach(TRSF_PTR trans, POS_PTR pos) {
@@ -983,20 +1012,190 @@ int teach(TRSF_PTR trans, POS_PTR pos) {
   return answer;
 }
 
+namespace {
+/// The words of `what` (fx fy fz tx ty tz, and `extra` when given) with the value that follows
+/// each among the arguments: what comply() and limit() read. Throws std::invalid_argument.
+std::vector<std::pair<std::size_t, double>> force_words(const char* call, const std::string& text,
+                                                        const std::array<double, 16>& values,
+                                                        bool with_values) {
+  std::vector<std::pair<std::size_t, double>> out;
+  std::size_t k = 0;
+  std::string word;
+  const auto take = [&](const std::string& w) {
+    if (w.empty()) return;
+    std::size_t axis = 6;  // "f": the force's magnitude (limit only)
+    const auto it = std::find(rc::kForceAxisNames.begin(), rc::kForceAxisNames.end(), w);
+    if (it != rc::kForceAxisNames.end()) {
+      axis = static_cast<std::size_t>(it - rc::kForceAxisNames.begin());
+    } else if (!(w == "f" && std::string_view(call) == "limit")) {
+      throw std::invalid_argument(fmt::format(
+          "{}(\"{}\"): unknown axis \"{}\"; the words are fx fy fz (N) and tx ty tz (N m) of "
+          "the tool frame{}",
+          call, text, w,
+          std::string_view(call) == "limit" ? ", or f (the force's magnitude)" : ""));
+    }
+    double v = 0.0;
+    if (with_values) {
+      if (k >= values.size()) throw std::invalid_argument(fmt::format("{}: too many words", call));
+      v = values[k++];
+      if (!std::isfinite(v)) {
+        throw std::invalid_argument(
+            fmt::format("{}(\"{}\"): the value of {} is not finite", call, text, w));
+      }
+    }
+    out.emplace_back(axis, v);
+  };
+  for (const char c : text) {
+    if (c == ' ' || c == ',' || c == '\t') {
+      take(word);
+      word.clear();
+    } else {
+      word += c;
+    }
+  }
+  take(word);
+  if (out.empty()) {
+    throw std::invalid_argument(
+        fmt::format("{}: no axis given; e.g. {}(\"fz\"{})", call, call, with_values ? ", 5." : ""));
+  }
+  return out;
+}
+
+/// Reads one double per word of `what` (before anything can throw).
+std::array<double, 16> word_values(const char* what, std::va_list ap) {
+  std::array<double, 16> values{};
+  std::size_t words = 0;
+  bool in_word = false;
+  for (const char* c = what; c != nullptr && *c != '\0'; ++c) {
+    const bool sep = *c == ' ' || *c == ',' || *c == '\t';
+    if (!sep && !in_word && words < values.size()) values[words++] = va_arg(ap, double);
+    in_word = !sep;
+  }
+  return values;
+}
+}  // namespace
+
 int comply(const char* what, ...) {
-  return fail(RTC_E_NOT_YET,
-              fmt::format("comply(\"{}\"): compliance needs force sensing, which this version "
-                          "of rccx does not have yet; the motion runs without it",
-                          what != nullptr ? what : ""),
-              Say::print);
+  std::va_list ap;
+  va_start(ap, what);
+  const std::array<double, 16> values = word_values(what, ap);
+  va_end(ap);
+  return guarded("comply", Say::print, RTC_E_ARGUMENT, [&] {
+    State& s = state();
+    rc::Compliance c = s.settings.compliance;
+    for (const auto& [axis, value] : force_words("comply", what ? what : "", values, true)) {
+      c.axes = static_cast<std::uint8_t>(c.axes | (1U << axis));
+      c.force[axis] = value;
+    }
+    try {
+      rc::check_compliance(c);
+    } catch (const rc::MotionError& e) {
+      throw std::invalid_argument(e.what());  // a bad argument: nothing changed
+    }
+    s.settings.compliance = c;
+    return RTC_OK;
+  });
 }
 
 int lock(const char* what) {
-  return fail(RTC_E_NOT_YET,
-              fmt::format("lock(\"{}\"): compliance (comply / lock) is not in this version of "
-                          "rccx yet; nothing changed",
-                          what != nullptr ? what : ""),
-              Say::print);
+  return guarded("lock", Say::print, RTC_E_ARGUMENT, [&] {
+    State& s = state();
+    const std::string text = what ? what : "";
+    rc::Compliance c = s.settings.compliance;
+    if (text == "all") {
+      c = rc::Compliance{};
+    } else {
+      for (const auto& [axis, value] : force_words("lock", text, {}, false)) {
+        c.axes = static_cast<std::uint8_t>(c.axes & ~(1U << axis));
+        c.force[axis] = 0.0;
+      }
+    }
+    s.settings.compliance = c;
+    return RTC_OK;
+  });
+}
+
+int limit(const char* what, ...) {
+  std::va_list ap;
+  va_start(ap, what);
+  const std::array<double, 16> values = word_values(what, ap);
+  va_end(ap);
+  return guarded("limit", Say::print, RTC_E_ARGUMENT, [&] {
+    State& s = state();
+    const std::string text = what ? what : "";
+    if (text == "off" || text.empty()) {
+      s.settings.guard = rc::ForceGuard{};
+      return RTC_OK;
+    }
+    const auto words = force_words("limit", text, values, true);
+    if (words.size() != 1) {
+      return fail(RTC_E_ARGUMENT,
+                  fmt::format("limit(\"{}\"): one axis at a time (or f, the magnitude)", text),
+                  Say::print);
+    }
+    rc::ForceGuard g;
+    g.kind = words[0].first == 6 ? rc::ForceGuard::Kind::magnitude : rc::ForceGuard::Kind::along;
+    g.axis = static_cast<std::uint8_t>(words[0].first % 6);
+    g.threshold = words[0].second;
+    try {
+      rc::check_guard(g);
+    } catch (const rc::MotionError& e) {
+      throw std::invalid_argument(e.what());
+    }
+    s.settings.guard = g;
+    return RTC_OK;
+  });
+}
+
+int setload(double kg, double x, double y, double z) {
+  return guarded("setload", Say::print, RTC_E_ARGUMENT, [&] {
+    State& s = state();
+    if (!(kg >= 0.0) || !std::isfinite(kg) || !std::isfinite(x) || !std::isfinite(y) ||
+        !std::isfinite(z)) {
+      return fail(RTC_E_ARGUMENT,
+                  fmt::format("setload({}, {}, {}, {}): the mass is >= 0 kg and the centre of "
+                              "mass finite (mm in T6)",
+                              kg, x, y, z),
+                  Say::print);
+    }
+    if (!s.arm) return fail(RTC_E_SEQUENCE, "setload: call rccl_open() first", Say::print);
+    rccx::force::ToolLoad load;
+    load.mass_kg = kg;
+    load.com_m = {x * 1e-3, y * 1e-3, z * 1e-3};
+    s.arm->set_tool_load(load);
+    return RTC_OK;
+  });
+}
+
+int getcontact(POS_PTR pos, TRSF_PTR at) {
+  int answer = NO;
+  guarded("getcontact", Say::print, RTC_E_ARGUMENT, [&] {
+    State& s = state();
+    PositionBox* box = position_of(pos, "getcontact");
+    if (box == nullptr) return rtc_error;
+    const std::optional<rc::Contact> c = last_contact(s, box);
+    if (!c) return RTC_OK;
+    if (at != nullptr) to_c(c->tool_frame, *at);
+    answer = YES;
+    return RTC_OK;
+  });
+  return answer;
+}
+
+TRSF_PTR updatecontact(TRSF_PTR trans, POS_PTR pos) {
+  State& s = state();
+  PositionBox* box = position_of(pos, "updatecontact");
+  if (box == nullptr) return nullptr;
+  const std::optional<rc::Contact> c = last_contact(s, box);
+  if (!c) {
+    fail(RTC_E_SEQUENCE,
+         fmt::format("updatecontact(..., {}): the last motion to {} made no contact (set a "
+                     "limit() before it, and waitfor its end)",
+                     box->name, box->name),
+         Say::print);
+    return nullptr;
+  }
+  return solve_update("updatecontact", trans, pos, c->t6);
 }
 
 }  // extern "C"

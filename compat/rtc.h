@@ -27,7 +27,7 @@ extern "C" {
 #define RTC_E_MOTION 7      /* a queued motion failed (or was cancelled) while running */
 #define RTC_E_TERMINATED 8  /* control ended by itself: a limit, a fault, Ctrl-C */
 #define RTC_E_INTERNAL 9    /* an unexpected failure inside rccx (the message says which) */
-#define RTC_E_NOT_YET 10    /* a call rccx declares but does not do yet (comply, lock) */
+#define RTC_E_NOT_YET 10    /* a call rccx declares but does not do yet */
 
 /** The code of the last error (RTC_OK until one happens). */
 extern int rtc_error;

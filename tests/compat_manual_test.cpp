@@ -181,8 +181,15 @@ TEST_F(CompatManual, BadTransformsAndEquationsAreRefusedAndChangeNothing) {
   EXPECT_NE(message().find("tool"), std::string::npos) << message();
   EXPECT_EQ(distance("dq", 1.0), RTC_E_ARGUMENT);
   EXPECT_NE(message().find("dx dy dz"), std::string::npos) << message();
-  EXPECT_EQ(comply("fz", 10.0), RTC_E_NOT_YET);
-  EXPECT_EQ(lock("fz"), RTC_E_NOT_YET);
+  EXPECT_EQ(comply("fq", 10.0), RTC_E_ARGUMENT);
+  EXPECT_NE(message().find("fx fy fz"), std::string::npos) << message();
+  EXPECT_EQ(comply("fz", NAN), RTC_E_ARGUMENT);
+  EXPECT_EQ(limit("fz fx", 1.0, 2.0), RTC_E_ARGUMENT);
+  EXPECT_NE(message().find("one axis"), std::string::npos) << message();
+  EXPECT_EQ(limit("f", -3.0), RTC_E_ARGUMENT);
+  EXPECT_EQ(lock("fw"), RTC_E_ARGUMENT);
+  EXPECT_EQ(lock("all"), RTC_OK);
+  EXPECT_EQ(limit("off"), RTC_OK);
 
   // A hold set to something that is not a rotation: refused at move(), nothing queued.
   open_parked();

@@ -322,7 +322,7 @@ Motion Manipulator::move(const PositionPtr& position, const StartWhen& when) {
   return m;
 }
 
-void Manipulator::set_guard(const ForceGuard& guard) {
+void check_guard(const ForceGuard& guard) {
   if (guard.on()) {
     if (!std::isfinite(guard.threshold) || guard.threshold == 0.0) {
       throw MotionError(
@@ -338,10 +338,14 @@ void Manipulator::set_guard(const ForceGuard& guard) {
       throw MotionError("a force guard on the magnitude needs a threshold > 0 N");
     }
   }
+}
+
+void Manipulator::set_guard(const ForceGuard& guard) {
+  check_guard(guard);
   settings_.guard = guard;
 }
 
-void Manipulator::set_compliance(const Compliance& c) {
+void check_compliance(const Compliance& c) {
   const auto positive = [](double x) { return std::isfinite(x) && x > 0.0; };
   for (std::size_t i = 0; i < 6; ++i) {
     const bool ok = std::isfinite(c.force[i]) && std::isfinite(c.stiffness[i]) &&
@@ -365,6 +369,10 @@ void Manipulator::set_compliance(const Compliance& c) {
                                     kForceAxisNames[i], c.force[i], c.max_force_N));
     }
   }
+}
+
+void Manipulator::set_compliance(const Compliance& c) {
+  check_compliance(c);
   settings_.compliance = c;
 }
 

@@ -38,6 +38,10 @@ class MotionError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// Throw MotionError, saying what is wrong, for a guard or a compliance that cannot be used.
+void check_guard(const ForceGuard& guard);
+void check_compliance(const Compliance& compliance);
+
 /// Something a program may wait for.
 struct Event {
   enum class Kind : std::uint8_t { motion_start, motion_end, position_end, completed };
