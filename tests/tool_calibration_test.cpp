@@ -8,6 +8,7 @@
 #include <Eigen/Dense>
 #include <cmath>
 #include <memory>
+#include <stdexcept>
 #include <string>
 
 #include "rccx/force/tool_load.hpp"
@@ -32,8 +33,14 @@ Eigen::Vector3d E(const math::Vec3& v) {
 /// wrist_wrench is the tool's weight at the arm's true pose, as a sensor at T6 would feel it.
 class ToolArm final : public hw::SimulatedArm {
  public:
-  ToolArm(const kin::RobotModel& model, double mass_kg, const math::Vec3& com_m)
-      : inner_(model), kinematics_(kin::make_kinematics(model)), mass_(mass_kg), com_(com_m) {}
+  ToolArm(const kin::RobotModel& model, double mass_kg, const math::Vec3& com_m,
+          const hw::SimulatedArmOptions& options = {})
+      : inner_(model, options),
+        kinematics_(kin::make_kinematics(model)),
+        mass_(mass_kg),
+        com_(com_m) {}
+  /// A contact on the tool: its wrench about T6's origin in T6's axes (between samples).
+  void set_contact(const math::Wrench& w) { contact_ = w; }
 
   [[nodiscard]] const kin::RobotModel& model() const noexcept override { return inner_.model(); }
   void advance_to(double t_s) noexcept override { inner_.advance_to(t_s); }
@@ -64,7 +71,7 @@ class ToolArm final : public hw::SimulatedArm {
   }
 
   [[nodiscard]] bool wrist_wrench(math::Wrench& w) const noexcept override {
-    w = weight_at(kinematics_->forward(true_position()).R);
+    w = weight_at(kinematics_->forward(true_position()).R) + contact_;
     return true;
   }
   /// The tool's weight at T6 for T6's orientation `R` (world = base, gravity along -z), worked
@@ -85,6 +92,27 @@ class ToolArm final : public hw::SimulatedArm {
   std::unique_ptr<kin::Kinematics> kinematics_;
   double mass_;
   math::Vec3 com_;
+  math::Wrench contact_;
+};
+
+/// The arm, its driver (with the sensor's bias), a simulated session and a started manipulator.
+struct Rig {
+  Rig(double mass_kg, const math::Vec3& com_m, const math::Wrench& bias,
+      const hw::SimulatedArmOptions& options = {})
+      : arm(kin::builtin_robot("puma560"), mass_kg, com_m, options), driver(arm) {
+    hw::ForceSensorSpec spec;  // the default noise: 0.06 N, 0.002 N m
+    spec.bias = bias;
+    spec.seed = 7;
+    if (!driver.set_force_sensor_spec(spec)) throw std::logic_error("no sensor");
+    session = std::make_unique<rtc::Session>(driver);
+    manipulator = std::make_unique<rccl::Manipulator>(*session);
+    manipulator->start();
+    (void)session->wait_for(50ms);
+  }
+  ToolArm arm;
+  rtc::ServoDriver driver;
+  std::unique_ptr<rtc::Session> session;
+  std::unique_ptr<rccl::Manipulator> manipulator;
 };
 
 TEST(ToolCalibration, RecoversTheToolAndTheSensorsBias) {
@@ -133,6 +161,70 @@ TEST(ToolCalibration, RecoversTheToolAndTheSensorsBias) {
     EXPECT_LT(E(left.torque_N_m).norm(), 0.003);
   }
   EXPECT_FALSE(manipulator.stop_control().ended());
+}
+
+TEST(ToolCalibration, CompensatedReadingsGiveTheContactAtTheTool) {
+  // Calibrate, then push the tool's tip (0.1 m out along T6's a axis) with a known force: the
+  // reading, compensated and carried to the tool, is that force, to the averaged noise.
+  const math::Wrench bias{{-0.4, 0.9, 1.7}, {-0.02, 0.01, 0.03}};
+  Rig rig(0.6, {0.0, 0.01, 0.05}, bias);
+  const force::ToolLoad load = rccl::calibrate_tool_load(*rig.manipulator);
+  const math::Transform tool = math::Transform::translation(0.0, 0.0, 0.1);
+  const Eigen::Vector3d F(3.0, -2.0, 5.0);                             // tool axes = T6 axes
+  const Eigen::Vector3d moment = Eigen::Vector3d(0, 0, 0.1).cross(F);  // about T6's origin
+  rig.arm.set_contact({{F.x(), F.y(), F.z()}, {moment.x(), moment.y(), moment.z()}});
+  (void)rig.session->wait_for(30ms);  // the How at hand was read before the push
+  math::Wrench sum;
+  int n = 0;
+  (void)rig.session->wait_until(
+      [&](const rtc::How& h) {
+        const math::Rot3 R = rig.manipulator->kinematics().forward(h.q()).R;
+        sum = sum + force::at_tool(tool, force::external_wrench(load, R, h.force.wrench));
+        return ++n >= 25;
+      },
+      5s);
+  ASSERT_EQ(n, 25);
+  const math::Wrench mean = sum * (1.0 / n);
+  EXPECT_LT((E(mean.force_N) - F).norm(), 0.06);
+  EXPECT_LT(E(mean.torque_N_m).norm(), 0.003);
+  // Without the compensation, the tool's weight and the bias would be off by newtons.
+  EXPECT_GT((E(force::at_tool(tool, rig.session->how().force.wrench).force_N) - F).norm(), 1.0);
+}
+
+TEST(ToolCalibration, TurnsTheOtherWayNearALimit) {
+  // Joint 5 starts 5 deg from its upper limit (100 deg): the turns that would pass it go the
+  // other way; every pose is within the limits and the tool is still recovered.
+  const kin::RobotModel model = kin::builtin_robot("puma560");
+  hw::SimulatedArmOptions options;
+  options.initial = model.ready();
+  options.initial[4] = model.joints[4].upper - 0.087;
+  options.initial[3] = model.joints[3].lower + 0.2;  // joint 4, 11 deg from its lower limit
+  Rig rig(0.9, {0.02, 0.0, 0.07}, {}, options);
+  rccl::ToolCalibrationReadings readings;
+  const force::ToolLoad load = rccl::calibrate_tool_load(*rig.manipulator, {}, nullptr, &readings);
+  EXPECT_NEAR(load.mass_kg, 0.9, 0.005);
+  EXPECT_LT((E(load.com_m) - Eigen::Vector3d(0.02, 0.0, 0.07)).norm(), 0.003);
+  ASSERT_EQ(readings.joints.size(), 6U);
+  bool went_down = false;
+  for (const auto& q : readings.joints) {
+    for (std::size_t j = 3; j < 6; ++j) {
+      EXPECT_GE(q[j], model.joints[j].lower - 1e-3) << j;
+      EXPECT_LE(q[j], model.joints[j].upper + 1e-3) << j;
+    }
+    went_down = went_down || q[4] < options.initial[4] - 0.6;
+  }
+  EXPECT_TRUE(went_down);
+}
+
+TEST(ToolCalibration, AFrozenSensorEndsItWithTheReason) {
+  Rig rig(0.5, {}, {});
+  rig.driver.force_sensor()->set_frozen(true);
+  try {
+    (void)rccl::calibrate_tool_load(*rig.manipulator);
+    ADD_FAILURE() << "calibrated with a frozen sensor";
+  } catch (const rccl::ToolCalibrationError& e) {
+    EXPECT_NE(std::string(e.what()).find("froze"), std::string::npos) << e.what();
+  }
 }
 
 TEST(ToolCalibration, RefusesARobotWithoutAWristSensor) {

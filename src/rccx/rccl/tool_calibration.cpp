@@ -40,10 +40,20 @@ std::string robot_name(Manipulator& arm) {
   return arm.kinematics().model().name;
 }
 
+/// Control ended (a limit, a fault, the sensor saturated or frozen): says which.
+[[noreturn]] void throw_ended(Manipulator& arm, const std::string& name) {
+  const rtc::Termination t = arm.session().termination();
+  throw ToolCalibrationError(fmt::format(
+      "tool calibration on {}: control ended at {}: {} ({}){}{}; see to it and calibrate again",
+      robot_name(arm), name, rtc::to_string(t.code), rtc::describe(t.code),
+      t.detail_view().empty() ? "" : ": ", t.detail_view()));
+}
+
 void move_and_settle(Manipulator& arm, const kin::JointVector& q, const std::string& name,
                      const ToolCalibrationOptions& options) {
   const Motion m = arm.move(Position::joints(name, q));
   const WaitResult r = arm.waitfor(m.end(), options.timeout);
+  if (r == WaitResult::session_ended) throw_ended(arm, name);
   if (r != WaitResult::reached) {
     std::string why(to_string(r));
     for (const MotionEvent& e : arm.failures()) {
@@ -64,6 +74,7 @@ void move_and_settle(Manipulator& arm, const kin::JointVector& q, const std::str
         return true;
       },
       options.timeout);
+  if (!still && session.termination().ended()) throw_ended(arm, name);
   if (!still) {
     throw ToolCalibrationError(fmt::format(
         "tool calibration on {}: the arm did not come to rest at {} (every joint slower than "
@@ -71,10 +82,7 @@ void move_and_settle(Manipulator& arm, const kin::JointVector& q, const std::str
         robot_name(arm), name, rest));
   }
   const rtc::Termination t = session.wait_for(options.settle);
-  if (t.ended()) {
-    throw ToolCalibrationError(fmt::format("tool calibration on {}: control ended at {} ({})",
-                                           robot_name(arm), name, rtc::describe(t.code)));
-  }
+  if (t.ended()) throw_ended(arm, name);
 }
 
 /// Averages `n` distinct sensor readings; the measured joints of the last.
@@ -110,6 +118,7 @@ force::LoadSample average_readings(Manipulator& arm, const std::string& name,
         "calibrate again",
         robot_name(arm), fault, name));
   }
+  if (!done && arm.session().termination().ended()) throw_ended(arm, name);
   if (!done) {
     throw ToolCalibrationError(fmt::format(
         "tool calibration on {}: {} of {} sensor readings at {} before the time ran out",
