@@ -77,8 +77,8 @@ void move_and_settle(Manipulator& arm, const kin::JointVector& q, const std::str
   if (!still && session.termination().ended()) throw_ended(arm, name);
   if (!still) {
     throw ToolCalibrationError(fmt::format(
-        "tool calibration on {}: the arm did not come to rest at {} (every joint slower than "
-        "{}); check that nothing pushes it, or raise rest_speed",
+        "tool calibration on {}: the arm did not come to rest at {} (no sample with every "
+        "joint slower than {} rad/s or m/s); check that nothing pushes it, or raise rest_speed",
         robot_name(arm), name, rest));
   }
   const rtc::Termination t = session.wait_for(options.settle);
