@@ -2,6 +2,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "rccx/force/tool_load.hpp"
 #include "rccx/kinematics/robot_model.hpp"
 #include "rccx/rccl/manipulator.hpp"
 #include "rccx/rtc/simulated_robot.hpp"
@@ -18,5 +19,11 @@ int main() {
   robot.session->wait_for(std::chrono::milliseconds(500));
   const double error_rad = std::abs(robot.session->how().q()[0] - goal[0]);
   std::printf("outside: joint 1 within %.2g rad of its goal\n", error_rad);
-  return error_rad < 1e-3 ? 0 : 1;
+  // rccx::force: a 2 kg tool hanging from T6 reads its weight, which compensation removes.
+  const math::Rot3 down = math::Rot3::rot_x(3.141592653589793);
+  const force::ToolLoad tool{{}, 2.0, {0.0, 0.0, 0.1}};
+  const math::Wrench weight{{0.0, 0.0, 2.0 * 9.81}, {0.0, 0.0, 0.0}};
+  const double left_N = force::external_wrench(tool, down, weight).force_N.norm();
+  std::printf("outside: a hanging tool compensated to %.2g N\n", left_N);
+  return error_rad < 1e-3 && left_N < 1e-9 ? 0 : 1;
 }
