@@ -51,7 +51,9 @@ TEST(HwFactory, PicksThePumaSimulatorWhenEveryJointHasDynamics) {
   partial.joints[4].dynamics = {};
   EXPECT_FALSE(is_puma(*hw::make_simulated_arm(partial)));
   EXPECT_THROW(hw::SimulatedPuma{partial}, std::invalid_argument);
-  EXPECT_THROW((void)hw::make_simulated_arm(kin::builtin_robot("puma560"), {{0.0, 0.0}}),
+  hw::SimulatedArmOptions two_values;
+  two_values.initial = {0.0, 0.0};
+  EXPECT_THROW((void)hw::make_simulated_arm(kin::builtin_robot("puma560"), two_values),
                std::invalid_argument);
   EXPECT_EQ(hw::to_string(hw::Fault::joint_not_answering), "joint_not_answering");
   EXPECT_EQ(hw::to_string(hw::Fault::encoder_error), "encoder_error");
@@ -197,7 +199,10 @@ TEST_P(HwArm, CalibratesFromAnUncalibratedStart) {
     start[j] += 0.05 * (joint.upper - joint.lower) * (j % 2 == 0 ? 1 : -1);
     start[j] = std::clamp(start[j], joint.lower, joint.upper);
   }
-  const auto arm = hw::make_simulated_arm(model_, {start, false});
+  hw::SimulatedArmOptions options;
+  options.initial = start;
+  options.calibrated = false;
+  const auto arm = hw::make_simulated_arm(model_, options);
   for (std::size_t j = 0; j < arm->dof(); ++j) {
     const hw::JointReading r = arm->read(j);
     EXPECT_FALSE(r.calibrated);
@@ -439,7 +444,9 @@ TEST(HwGravity, Puma560ArmOutstretchedLoadsTheShoulder) {
 TEST(HwPuma, HoldsItsPoseUnderGravityWithTheServoOn) {
   for (const kin::JointVector& pose :
        {kin::JointVector{0, 0, 0, 0, 0, 0}, kin::JointVector{0.3, 0.2, -0.5, 0.5, -0.7, 0.2}}) {
-    hw::SimulatedPuma arm(kin::builtin_robot("puma560"), {pose, true});
+    hw::SimulatedArmOptions options;
+    options.initial = pose;
+    hw::SimulatedPuma arm(kin::builtin_robot("puma560"), options);
     const kin::JointVector load = arm.gravity_load(pose);
     ASSERT_GT(std::abs(load[1]), 10.0);
     double worst = 0.0;

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <string>
+#include <utility>
 
 #include "rccx/kinematics/kinematics.hpp"
 #include "rccx/math/units.hpp"
@@ -160,6 +162,25 @@ TEST(RobotFile, RefusesBadInputWithMessagesThatSayWhere) {
                         "\"solver\": \"dh\", \"hardware\": {\"rcu\": " + std::string(deep, '[') +
                             std::string(deep, ']') + "}"),
                "nested more than 32 deep");
+}
+
+TEST(RobotFile, ChoosesItsSimulatedPlant) {
+  EXPECT_EQ(kin::parse_robot(kGoodRobot, "test").plant, kin::Plant::automatic);
+  for (const auto& [text, plant] :
+       {std::pair{"ideal", kin::Plant::ideal}, std::pair{"servo", kin::Plant::servo},
+        std::pair{"mujoco", kin::Plant::mujoco}}) {
+    const kin::RobotModel m =
+        kin::parse_robot(replaced(kGoodRobot, "\"solver\": \"dh\"",
+                                  "\"solver\": \"dh\", \"plant\": \"" + std::string(text) + "\""),
+                         "test");
+    EXPECT_EQ(m.plant, plant) << text;
+    EXPECT_EQ(kin::to_string(m.plant), text);
+  }
+  expect_error(
+      replaced(kGoodRobot, "\"solver\": \"dh\"", "\"solver\": \"dh\", \"plant\": \"bullet\""),
+      "\"plant\" is \"bullet\"; use \"ideal\", \"servo\" or \"mujoco\"");
+  expect_error(replaced(kGoodRobot, "\"solver\": \"dh\"", "\"solver\": \"dh\", \"plant\": 1"),
+               "\"plant\" must be a string");
 }
 
 TEST(RobotFile, RefusesAMissingOrBadMaxVelocity) {

@@ -1,6 +1,7 @@
 #include "rccx/hw/simulated_arm.hpp"
 
 #include "rccx/hw/ideal_arm.hpp"
+#include "rccx/hw/mujoco_arm.hpp"
 #include "rccx/hw/simulated_puma.hpp"
 
 namespace rccx::hw {
@@ -19,6 +20,17 @@ std::string_view to_string(Fault f) noexcept {
 
 std::unique_ptr<SimulatedArm> make_simulated_arm(const kin::RobotModel& model,
                                                  const SimulatedArmOptions& options) {
+  const Plant plant = options.plant != Plant::automatic ? options.plant : model.plant;
+  switch (plant) {
+    case Plant::ideal:
+      return std::make_unique<IdealArm>(model, options);
+    case Plant::servo:
+      return std::make_unique<SimulatedPuma>(model, options);
+    case Plant::mujoco:
+      return std::make_unique<MujocoArm>(model, options);
+    case Plant::automatic:
+      break;
+  }
   if (SimulatedPuma::can_simulate(model)) return std::make_unique<SimulatedPuma>(model, options);
   return std::make_unique<IdealArm>(model, options);
 }

@@ -58,11 +58,23 @@ enum class Fault : std::uint8_t {
 };
 std::string_view to_string(Fault f) noexcept;
 
+struct Scene;  // mjcf.hpp: what surrounds a MuJoCo arm
+
+/// Which plant simulates the arm (kin::Plant, the robot file's "plant"): automatic, ideal
+/// (IdealArm), servo (SimulatedPuma) or mujoco (MujocoArm).
+using Plant = kin::Plant;
+
 /// How a simulated arm starts.
 struct SimulatedArmOptions {
   kin::JointVector initial;  ///< initial joint values, rad or m; empty: the model's ready pose
   bool calibrated = true;  ///< false: counts are relative to the initial position until calibrated
   bool powered = true;     ///< arm power on (servo holding the initial position) or off (brakes)
+  /// The plant; automatic: the robot file's "plant", and when that is automatic too, the
+  /// simulated PUMA or the ideal servo as make_simulated_arm says.
+  Plant plant = Plant::automatic;
+  /// What surrounds a MuJoCo arm (the table, objects, the tool, the base's place); null: nothing,
+  /// the base at the world's origin. Other plants ignore it.
+  std::shared_ptr<const Scene> scene;
 };
 
 class SimulatedArm {
@@ -119,10 +131,13 @@ class SimulatedArm {
   }
 };
 
-/// The simulated arm for a model: a SimulatedPuma (simulated_puma.hpp: joint PID servos on a
-/// plant with inertia, friction and gravity) when every joint has dynamics (inertia and
-/// max_effort given), else an IdealArm (ideal_arm.hpp: joints follow their setpoints at up to
-/// their top speed). Throws std::invalid_argument for an unusable model or initial pose.
+/// The simulated arm for a model: the plant options.plant names, else the one the robot file's
+/// "plant" names (MujocoArm, mujoco_arm.hpp: MuJoCo with contact and a wrist sensor; or one of
+/// the two below), else a SimulatedPuma (simulated_puma.hpp: joint PID servos on a plant with
+/// inertia, friction and gravity) when every joint has dynamics (inertia and max_effort given),
+/// else an IdealArm (ideal_arm.hpp: joints follow their setpoints at up to their top speed).
+/// Throws std::invalid_argument for an unusable model or initial pose, or a servo plant for a
+/// model without dynamics.
 std::unique_ptr<SimulatedArm> make_simulated_arm(const kin::RobotModel& model,
                                                  const SimulatedArmOptions& options = {});
 

@@ -69,6 +69,20 @@ std::string_view to_string(SolverKind kind) noexcept {
   return "?";
 }
 
+std::string_view to_string(Plant plant) noexcept {
+  switch (plant) {
+    case Plant::automatic:
+      return "automatic";
+    case Plant::ideal:
+      return "ideal";
+    case Plant::servo:
+      return "servo";
+    case Plant::mujoco:
+      return "mujoco";
+  }
+  return "?";
+}
+
 namespace {
 
 using Reader = io::JsonObjectReader<RobotFileError>;
@@ -224,6 +238,20 @@ RobotModel parse_robot_json(std::string_view json_text, std::string_view origin)
     const json& hardware = r.get("hardware");
     if (!hardware.is_object()) r.fail("\"hardware\" must be an object");
     model.hardware_json = hardware.dump();
+  }
+  if (r.has("plant")) {
+    const std::string plant = r.string("plant");
+    if (plant == "ideal") {
+      model.plant = Plant::ideal;
+    } else if (plant == "servo") {
+      model.plant = Plant::servo;
+    } else if (plant == "mujoco") {
+      model.plant = Plant::mujoco;
+    } else {
+      r.fail(
+          fmt::format("\"plant\" is {}; use \"ideal\", \"servo\" or \"mujoco\" (or leave it out)",
+                      io::quoted(plant)));
+    }
   }
   r.no_unknown_keys();
   return model;

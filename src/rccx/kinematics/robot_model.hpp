@@ -53,6 +53,11 @@ struct Joint {
 /// form, or the numeric solver that serves any DH chain.
 enum class SolverKind : std::uint8_t { microbo, puma, dh };
 
+/// Which simulated plant serves the robot below the wire (rccx::hw::make_simulated_arm): the
+/// file's optional "plant". automatic: the Microbo's RCU when the file has one, else the
+/// simulated PUMA when every joint has dynamics, else the ideal servo.
+enum class Plant : std::uint8_t { automatic, ideal, servo, mujoco };
+
 struct RobotModel {
   std::string name;    ///< short id used on the command line ("microbo", "puma560")
   std::string title;   ///< human name
@@ -62,6 +67,7 @@ struct RobotModel {
   /// The file's "hardware" object as JSON text (empty when none): what a simulator of this
   /// robot's controller needs (the Microbo's RCU), parsed and checked by rccx::hw.
   std::string hardware_json;
+  Plant plant = Plant::automatic;
 
   [[nodiscard]] std::size_t dof() const noexcept { return joints.size(); }
   [[nodiscard]] JointVector ready() const noexcept;
@@ -93,5 +99,6 @@ RobotModel builtin_robot(std::string_view name);
 
 std::string_view to_string(JointType type) noexcept;
 std::string_view to_string(SolverKind kind) noexcept;
+std::string_view to_string(Plant plant) noexcept;
 
 }  // namespace rccx::kin

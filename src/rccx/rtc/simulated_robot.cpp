@@ -1,25 +1,38 @@
 #include "rccx/rtc/simulated_robot.hpp"
 
-#include "rccx/hw/ideal_arm.hpp"
 #include "rccx/rtc/microbo_driver.hpp"
 #include "rccx/rtc/servo_driver.hpp"
 
 namespace rccx::rtc {
 
-std::chrono::nanoseconds SimulatedRobot::usual_period(const kin::RobotModel& model) {
+namespace {
+
+/// The RCU serves a robot whose file describes one, unless a plant is named.
+bool behind_rcu(const kin::RobotModel& model, hw::Plant plant) {
+  return !model.hardware_json.empty() && plant == hw::Plant::automatic &&
+         model.plant == hw::Plant::automatic;
+}
+
+}  // namespace
+
+std::chrono::nanoseconds SimulatedRobot::usual_period(const kin::RobotModel& model,
+                                                      hw::Plant plant) {
   using std::chrono::milliseconds;
-  return model.hardware_json.empty() ? milliseconds(10) : milliseconds(28);
+  return behind_rcu(model, plant) ? milliseconds(28) : milliseconds(10);
 }
 
 SimulatedHardware make_simulated_hardware(const kin::RobotModel& model, bool calibrated,
                                           bool ideal_servo) {
-  SimulatedHardware h;
   hw::SimulatedArmOptions arm_options;
   arm_options.calibrated = calibrated;
-  if (ideal_servo) {
-    h.arm = std::make_unique<hw::IdealArm>(model, arm_options);
-    h.driver = std::make_unique<ServoDriver>(*h.arm);
-  } else if (!model.hardware_json.empty()) {
+  if (ideal_servo) arm_options.plant = hw::Plant::ideal;
+  return make_simulated_hardware(model, arm_options);
+}
+
+SimulatedHardware make_simulated_hardware(const kin::RobotModel& model,
+                                          const hw::SimulatedArmOptions& arm_options) {
+  SimulatedHardware h;
+  if (behind_rcu(model, arm_options.plant)) {
     h.rcu = std::make_unique<hw::Rcu>(model, arm_options);
     h.bus = std::make_unique<hw::RcuBus>(*h.rcu);
     MicroboDriverOptions o;
@@ -34,13 +47,17 @@ SimulatedHardware make_simulated_hardware(const kin::RobotModel& model, bool cal
 
 SimulatedRobot::SimulatedRobot(kin::RobotModel m, const SimulatedRobotOptions& options)
     : model(std::move(m)) {
-  SimulatedHardware h = make_simulated_hardware(model, options.calibrated);
+  hw::SimulatedArmOptions arm_options;
+  arm_options.calibrated = options.calibrated;
+  arm_options.plant = options.plant;
+  arm_options.scene = options.scene;
+  SimulatedHardware h = make_simulated_hardware(model, arm_options);
   arm = std::move(h.arm);
   rcu = std::move(h.rcu);
   bus = std::move(h.bus);
   driver = std::move(h.driver);
   SessionOptions so;
-  so.period = options.period.count() > 0 ? options.period : usual_period(model);
+  so.period = options.period.count() > 0 ? options.period : usual_period(model, options.plant);
   so.clock = options.clock;
   session = std::make_unique<Session>(*driver, so);
   if (!options.log.empty()) {

@@ -1,7 +1,8 @@
 // A simulated robot below the wire with an RTC session on it, assembled in one call: the
 // Microbo's emulated RCU behind its bus and register-level driver when the robot file describes
-// an RCU, else a servo arm (the PUMA's PID servos, or the ideal servo for any robot file). What
-// the control programs, the examples and the compat layer all start from.
+// an RCU (and names no other plant), else a servo arm (MuJoCo when the file or the options say
+// "mujoco", the PUMA's PID servos, or the ideal servo for any robot file). What the control
+// programs, the examples and the compat layer all start from.
 #pragma once
 
 #include <chrono>
@@ -24,6 +25,10 @@ struct SimulatedRobotOptions {
   ClockKind clock = ClockKind::simulated;
   bool calibrated = true;     ///< false: encoders relative to power-up
   std::filesystem::path log;  ///< a CSV of every controlled sample; empty: none (or RCCX_LOG)
+  /// The plant below the wire; automatic: the robot file's choice (robots/README.md).
+  hw::Plant plant = hw::Plant::automatic;
+  /// What surrounds a MuJoCo arm (hw/mjcf.hpp); null: nothing.
+  std::shared_ptr<const hw::Scene> scene;
 };
 
 /// The part below the session: the simulated arm (or the Microbo's RCU and its bus) and the
@@ -35,8 +40,13 @@ struct SimulatedHardware {
   std::unique_ptr<Driver> driver;
 };
 
-/// Builds the hardware and driver of `model` (the Microbo's RCU when the robot file describes
-/// one, else a servo arm). Throws std::invalid_argument when the robot cannot be simulated.
+/// Builds the hardware and driver of `model`: the Microbo's RCU when the robot file describes
+/// one and neither the file nor arm_options.plant names a plant, else a servo arm
+/// (hw::make_simulated_arm) behind a ServoDriver. Throws std::invalid_argument when the robot
+/// cannot be simulated.
+SimulatedHardware make_simulated_hardware(const kin::RobotModel& model,
+                                          const hw::SimulatedArmOptions& arm_options);
+/// The same with the default options but `calibrated`; `ideal_servo` asks for the ideal servo.
 SimulatedHardware make_simulated_hardware(const kin::RobotModel& model, bool calibrated = true,
                                           bool ideal_servo = false);
 
@@ -53,8 +63,10 @@ struct SimulatedRobot {
   std::unique_ptr<SampleLog> log;
   std::unique_ptr<Session> session;
 
-  /// The usual sample period of a robot.
-  static std::chrono::nanoseconds usual_period(const kin::RobotModel& model);
+  /// The usual sample period of a robot (28 ms behind the Microbo's RCU, else 10 ms); `plant`
+  /// overrides the file's choice, as SimulatedRobotOptions::plant does.
+  static std::chrono::nanoseconds usual_period(const kin::RobotModel& model,
+                                               hw::Plant plant = hw::Plant::automatic);
   [[nodiscard]] bool simulated() const { return session->clock() == ClockKind::simulated; }
   [[nodiscard]] double period_s() const;
   /// A simulated hand pushes a joint (N m or N); only between samples of simulated time.

@@ -1,0 +1,288 @@
+#include "rccx/hw/mjcf.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <iterator>
+#include <stdexcept>
+
+#include "rccx/hw/arm_base.hpp"
+#include "rccx/hw/gravity.hpp"
+#include "rccx/hw/rcu.hpp"
+
+namespace rccx::hw {
+
+std::array<JointPlant, kin::kMaxJoints> joint_plants(const kin::RobotModel& model) {
+  std::array<JointPlant, kin::kMaxJoints> out{};
+  RcuConfig rcu;
+  if (!model.hardware_json.empty()) rcu = rcu_config(model);
+  const std::size_t n = std::min(model.dof(), kin::kMaxJoints);
+  for (std::size_t i = 0; i < n; ++i) {
+    const kin::Joint& j = model.joints[i];
+    const bool revolute = j.type == kin::JointType::revolute;
+    JointPlant& p = out[i];
+    const kin::JointDynamics& d = j.dynamics;
+    // The file's dynamics first, then the RCU's plant (the Microbo), then the defaults.
+    const RcuJointConfig* r = i < rcu.joints.size() ? &rcu.joints[i] : nullptr;
+    const auto pick = [](double file, double from_rcu, double fallback) {
+      return file > 0 ? file : (from_rcu > 0 ? from_rcu : fallback);
+    };
+    p.inertia = pick(d.inertia, r ? r->inertia : 0.0,
+                     revolute ? kDefaultInertia_kg_m2 : kDefaultInertia_kg);
+    p.viscous = pick(d.viscous_friction, r ? r->viscous_friction : 0.0, 0.0);
+    p.coulomb = pick(d.coulomb_friction, r ? r->coulomb_friction : 0.0, 0.0);
+    p.max_effort = pick(d.max_effort, r ? r->max_effort : 0.0,
+                        revolute ? kDefaultMaxEffort_N_m : kDefaultMaxEffort_N);
+    // The vendor law's stiffness: motor parameter 1 is the dynamic zone's bandwidth, rad/s.
+    p.bandwidth =
+        r && r->motor_parameters[0] > 0 ? r->motor_parameters[0] : kDefaultServoBandwidth_rad_per_s;
+  }
+  return out;
+}
+
+namespace {
+
+/// Shortest exact text of a double (MuJoCo reads it back to the same value).
+std::string num(double v) {
+  if (v == 0.0) return "0";  // also -0
+  return fmt::format("{}", v);
+}
+
+std::string vec(const math::Vec3& v) {
+  return fmt::format("{} {} {}", num(v.x), num(v.y), num(v.z));
+}
+
+/// The unit quaternion (w x y z) of a rotation matrix (Shepperd's method: the largest of the
+/// four candidates, so no precision is lost near any angle).
+std::array<double, 4> quaternion(const math::Rot3& R) {
+  const double m00 = R(0, 0), m11 = R(1, 1), m22 = R(2, 2);
+  const double trace = m00 + m11 + m22;
+  std::array<double, 4> q{};
+  if (trace >= m00 && trace >= m11 && trace >= m22) {
+    const double s = 2.0 * std::sqrt(1.0 + trace);
+    q = {0.25 * s, (R(2, 1) - R(1, 2)) / s, (R(0, 2) - R(2, 0)) / s, (R(1, 0) - R(0, 1)) / s};
+  } else if (m00 >= m11 && m00 >= m22) {
+    const double s = 2.0 * std::sqrt(1.0 + m00 - m11 - m22);
+    q = {(R(2, 1) - R(1, 2)) / s, 0.25 * s, (R(0, 1) + R(1, 0)) / s, (R(0, 2) + R(2, 0)) / s};
+  } else if (m11 >= m22) {
+    const double s = 2.0 * std::sqrt(1.0 + m11 - m00 - m22);
+    q = {(R(0, 2) - R(2, 0)) / s, (R(0, 1) + R(1, 0)) / s, 0.25 * s, (R(1, 2) + R(2, 1)) / s};
+  } else {
+    const double s = 2.0 * std::sqrt(1.0 + m22 - m00 - m11);
+    q = {(R(1, 0) - R(0, 1)) / s, (R(0, 2) + R(2, 0)) / s, (R(1, 2) + R(2, 1)) / s, 0.25 * s};
+  }
+  if (q[0] < 0) {
+    for (double& c : q) c = -c;
+  }
+  return q;
+}
+
+std::string pose(const math::Transform& T) {
+  const auto q = quaternion(T.R);
+  return fmt::format(R"(pos="{}" quat="{} {} {} {}")", vec(T.p), num(q[0]), num(q[1]), num(q[2]),
+                     num(q[3]));
+}
+
+/// The constant part of link i's A matrix: Rot(z, theta) Trans(z, d) Trans(x, a) Rot(x, alpha).
+math::Transform dh_constant(const kin::Joint& j) {
+  const double ct = std::cos(j.dh.theta_rad), st = std::sin(j.dh.theta_rad);
+  double ca = std::cos(j.dh.alpha_rad), sa = std::sin(j.dh.alpha_rad);
+  // As kin::DhChain snaps them, so that this chain and the solvers' agree exactly.
+  if (std::abs(ca) < 1e-15) ca = 0.0;
+  if (std::abs(sa) < 1e-15) sa = 0.0;
+  return {{{ct, st, 0.0}, {-st * ca, ct * ca, sa}, {st * sa, -ct * sa, ca}},
+          {j.dh.a_m * ct, j.dh.a_m * st, j.dh.d_m}};
+}
+
+bool usable_name(const std::string& s) {
+  return !s.empty() && s.size() <= 64 && std::all_of(s.begin(), s.end(), [](char c) {
+    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_';
+  });
+}
+
+void indent(std::string& out, std::size_t depth) {
+  out.append(2 * depth, ' ');
+}
+
+}  // namespace
+
+std::string make_mjcf(const kin::RobotModel& model, const Scene& scene) {
+  const std::size_t n = model.dof();
+  if (n == 0 || n > kin::kMaxJoints) {
+    throw std::invalid_argument(
+        fmt::format("{}: MuJoCo needs 1 to {} joints", model.name, kin::kMaxJoints));
+  }
+  if (scene.substeps < 1 || scene.substeps > 100) {
+    throw std::invalid_argument(
+        fmt::format("scene: {} MuJoCo steps a servo tick; give 1 to 100", scene.substeps));
+  }
+  if (!(scene.tool_mass_kg >= 0) || !(scene.tool_length_m >= 0) || !(scene.tool_radius_m > 0)) {
+    throw std::invalid_argument("scene: the tool's mass, length and radius must not be negative");
+  }
+  for (const SceneBox& b : scene.boxes) {
+    if (!usable_name(b.name)) {
+      throw std::invalid_argument(fmt::format(
+          "scene: box name \"{}\": use 1 to 64 letters, digits and underscores", b.name));
+    }
+    if (!(b.half_size_m.x > 0 && b.half_size_m.y > 0 && b.half_size_m.z > 0) || !(b.mass_kg >= 0) ||
+        !(b.friction >= 0)) {
+      throw std::invalid_argument(fmt::format(
+          "scene: box {} needs half sizes > 0, a mass and friction not negative", b.name));
+    }
+  }
+  const auto plants = joint_plants(model);
+  const double timestep = kServoPeriod_s / scene.substeps;
+
+  std::string x;
+  x += fmt::format("<mujoco model=\"{}\">\n", model.name);
+  x += "  <!-- generated by rccx::hw::make_mjcf from the robot file; SI units -->\n";
+  x += R"(  <compiler angle="radian" inertiafromgeom="false"/>)"
+       "\n";
+  x += fmt::format(
+      R"(  <option timestep="{}" gravity="0 0 {}" integrator="Euler" cone="pyramidal"/>)"
+      "\n",
+      num(timestep), num(-kGravity_m_per_s2));
+  x += "  <size nconmax=\"200\" njmax=\"600\"/>\n";
+  // Contact: stiff (a 2 ms time constant, critically damped; the safe minimum at 1 ms is 2
+  // steps), hard impedance, three-dimensional friction cones.
+  x += "  <default>\n";
+  x += "    <geom condim=\"3\" solref=\"0.002 1\" solimp=\"0.95 0.99 0.001\"/>\n";
+  x += "    <joint limited=\"true\" solreflimit=\"0.004 1\"/>\n";
+  x += "  </default>\n";
+  x += "  <worldbody>\n";
+
+  // The scene: fixed boxes straight in the world, free ones as bodies with a free joint.
+  // contype 1 / conaffinity 3: boxes touch boxes and the arm (contype 2 / conaffinity 1),
+  // which never touches itself.
+  for (const SceneBox& b : scene.boxes) {
+    const std::string geom = fmt::format(
+        R"(type="box" size="{}" friction="{} 0.005 0.0001" contype="1" conaffinity="3")",
+        vec(b.half_size_m), num(b.friction));
+    if (b.mass_kg == 0.0) {
+      x += fmt::format("    <geom name=\"{}\" {} {}/>\n", b.name, pose(b.pose_m), geom);
+    } else {
+      const math::Vec3& h = b.half_size_m;
+      const double m = b.mass_kg;
+      const math::Vec3 I{m / 3.0 * (h.y * h.y + h.z * h.z), m / 3.0 * (h.x * h.x + h.z * h.z),
+                         m / 3.0 * (h.x * h.x + h.y * h.y)};
+      x += fmt::format("    <body name=\"{}\" {}>\n", b.name, pose(b.pose_m));
+      x += fmt::format("      <freejoint name=\"{}_free\"/>\n", b.name);
+      x += fmt::format("      <inertial pos=\"0 0 0\" mass=\"{}\" diaginertia=\"{}\"/>\n", num(m),
+                       vec(I));
+      x += fmt::format("      <geom name=\"{}\" {}/>\n", b.name, geom);
+      x += "    </body>\n";
+    }
+  }
+
+  // The arm: base, then link1 .. link<n>, each carrying its joint at its origin along its z.
+  x += fmt::format("    <body name=\"base\" {}>\n", pose(scene.base_m));
+  std::size_t depth = 3;
+  for (std::size_t i = 0; i < n; ++i) {
+    const kin::Joint& j = model.joints[i];
+    const bool revolute = j.type == kin::JointType::revolute;
+    const JointPlant& p = plants[i];
+    const math::Transform C = dh_constant(j);
+    const math::Transform in_parent =
+        i == 0 ? math::Transform::identity() : dh_constant(model.joints[i - 1]);
+    indent(x, depth);
+    x += fmt::format("<body name=\"link{}\" {}>\n", i + 1, pose(in_parent));
+    ++depth;
+    const double margin = revolute ? kHardStopMargin_rad : kHardStopMargin_m;
+    indent(x, depth);
+    // Armature: the file's effective inertia (the motor reflected), so the servo's gains, set
+    // from it, never meet a joint lighter than they assume.
+    x += fmt::format(
+        R"(<joint name="j{}" type="{}" pos="0 0 0" axis="0 0 1" range="{} {}" armature="{}" damping="{}" frictionloss="{}"/>)"
+        "\n",
+        i + 1, revolute ? "hinge" : "slide", num(j.lower - margin), num(j.upper + margin),
+        num(p.inertia), num(p.viscous), num(p.coulomb));
+    // The link's mass at its centre of mass, given in DH frame i = this body x C.
+    const kin::JointDynamics& d = j.dynamics;
+    const double mass = d.link_mass_kg > 0 ? d.link_mass_kg : kDefaultLinkMass_kg;
+    const math::Vec3 com = C * math::Vec3{d.link_com_m[0], d.link_com_m[1], d.link_com_m[2]};
+    const double gyr = 0.4 * mass * kLinkGyrationSphere_m * kLinkGyrationSphere_m;
+    indent(x, depth);
+    x += fmt::format(R"(<inertial pos="{}" mass="{}" diaginertia="{} {} {}"/>)"
+                     "\n",
+                     vec(com), num(mass), num(gyr), num(gyr), num(gyr));
+    // The link's shape: a capsule from this body's origin to frame i's (a prismatic link also
+    // reaches back along its axis by its lower limit, as a sliding rod does).
+    const math::Vec3 from{0.0, 0.0, revolute ? 0.0 : -std::max(0.0, j.lower)};
+    const math::Vec3 to = C.p;
+    indent(x, depth);
+    if ((to - from).norm() < 1e-6) {
+      x += fmt::format(
+          R"(<geom name="link{}" type="sphere" size="{}" pos="{}" contype="2" conaffinity="1"/>)"
+          "\n",
+          i + 1, num(kLinkRadius_m), vec(to));
+    } else {
+      x += fmt::format(
+          R"(<geom name="link{}" type="capsule" size="{}" fromto="{} {}" contype="2" conaffinity="1"/>)"
+          "\n",
+          i + 1, num(kLinkRadius_m), vec(from), vec(to));
+    }
+  }
+  // T6, and the tool beyond the sensor: the sensor measures what the tool body exchanges with
+  // the last link.
+  const math::Transform C6 = dh_constant(model.joints[n - 1]);
+  indent(x, depth);
+  x += fmt::format("<site name=\"t6\" {} size=\"0.005\"/>\n", pose(C6));
+  indent(x, depth);
+  x += fmt::format("<body name=\"tool\" {}>\n", pose(C6));
+  ++depth;
+  indent(x, depth);
+  x += "<site name=\"ft\" pos=\"0 0 0\" size=\"0.01\"/>\n";
+  if (scene.tool_mass_kg > 0) {
+    const double m = scene.tool_mass_kg;
+    const double r = std::max(scene.tool_radius_m, 0.5 * scene.tool_length_m);
+    const double gyr = 0.4 * m * r * r;
+    indent(x, depth);
+    x += fmt::format(R"(<inertial pos="{}" mass="{}" diaginertia="{} {} {}"/>)"
+                     "\n",
+                     vec(scene.tool_com_m), num(m), num(gyr), num(gyr), num(gyr));
+  }
+  // The tip, the point that touches first, is at tool_length_m along T6's z.
+  const double r = scene.tool_radius_m;
+  const double axis_end = scene.tool_length_m - r;
+  indent(x, depth);
+  if (axis_end < 1e-6) {
+    x += fmt::format(
+        R"(<geom name="tool" type="sphere" size="{}" pos="0 0 {}" friction="0.5 0.005 0.0001" contype="2" conaffinity="1"/>)"
+        "\n",
+        num(r), num(axis_end));
+  } else {
+    x += fmt::format(
+        R"(<geom name="tool" type="capsule" size="{}" fromto="0 0 0 0 0 {}" friction="0.5 0.005 0.0001" contype="2" conaffinity="1"/>)"
+        "\n",
+        num(r), num(axis_end));
+  }
+  --depth;
+  indent(x, depth);
+  x += "</body>\n";
+  for (std::size_t i = n; i-- > 0;) {
+    --depth;
+    indent(x, depth);
+    x += "</body>\n";
+  }
+  x += "    </body>\n";
+  x += "  </worldbody>\n";
+
+  x += "  <actuator>\n";
+  for (std::size_t i = 0; i < n; ++i) {
+    const double e = plants[i].max_effort;
+    x += fmt::format(
+        R"(    <motor name="m{0}" joint="j{0}" gear="1" ctrllimited="true" ctrlrange="{1} {2}"/>)"
+        "\n",
+        i + 1, num(-e), num(e));
+  }
+  x += "  </actuator>\n";
+  x += "  <sensor>\n";
+  x += "    <force name=\"ft_force\" site=\"ft\"/>\n";
+  x += "    <torque name=\"ft_torque\" site=\"ft\"/>\n";
+  x += "  </sensor>\n";
+  x += "</mujoco>\n";
+  return x;
+}
+
+}  // namespace rccx::hw

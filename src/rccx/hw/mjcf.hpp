@@ -1,0 +1,89 @@
+// A robot file as a MuJoCo model (MJCF, the XML MuJoCo 2.2 loads): the arm's DH chain as a
+// chain of bodies, one joint each (hinge or slide, the file's limits widened to the hard stops),
+// masses and inertias where the file gives them, a motor per joint, a tool body beyond a
+// six-axis force/torque sensor at T6, and the cell's table and objects as boxes. What MujocoArm
+// (mujoco_arm.hpp) loads; a person may load the same text in MuJoCo's viewer.
+//
+// Frames. Body "link<i>" (i = 1 .. dof) carries joint i: its frame is DH frame i-1 moved by the
+// joint, Rot(z, q) or Trans(z, q), and the constant part of A_i, Rot(z, theta) Trans(z, d)
+// Trans(x, a) Rot(x, alpha), is where link<i+1> (or the site "t6") sits in it (the joint's
+// motion commutes with the first two factors). So link<i>'s DH frame i is link<i> x C_i, the
+// file's centre of mass of link i is given there, and the site "t6" is T6 exactly (the FK test
+// compares it with Kinematics::forward at 1e-9). The robot's base is a body "base" placed at
+// Scene::base_m in the world; gravity is along world -z.
+//
+// Contact: the arm's and the tool's geoms touch the scene's boxes and never each other; boxes
+// touch each other. Stiff contact (solref 2 ms, critically damped; solimp 0.95 .. 0.99) and
+// modest friction (each box's; the tool's and arm's 0.5).
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "rccx/kinematics/joint_vector.hpp"
+#include "rccx/kinematics/robot_model.hpp"
+#include "rccx/math/transform.hpp"
+
+namespace rccx::hw {
+
+/// A box in the cell: a table (fixed) or an object on it (free, with mass).
+struct SceneBox {
+  std::string name;        ///< the body's and geom's name in the model (letters, digits, _)
+  math::Transform pose_m;  ///< the box's centre and axes in the world
+  math::Vec3 half_size_m;  ///< half its extent along its x, y, z
+  double mass_kg = 0.0;    ///< 0: fixed to the world; > 0: a free body of uniform density
+  double friction = 0.5;   ///< sliding friction coefficient
+};
+
+/// What surrounds the arm in MuJoCo.
+struct Scene {
+  std::vector<SceneBox> boxes;
+  math::Transform base_m;     ///< the robot's base frame in the world (world z is up)
+  double tool_mass_kg = 0.0;  ///< the tool beyond the sensor (0: none, only its geometry)
+  math::Vec3 tool_com_m;      ///< its centre of mass in T6
+  /// The tool: a capsule along T6's z from T6 to this length, whose round tip (radius
+  /// tool_radius_m) can touch; 0: a sphere of that radius at T6.
+  double tool_length_m = 0.0;
+  double tool_radius_m = 0.01;
+  /// MuJoCo steps per 1 ms servo tick (the time step is 1 ms / substeps).
+  int substeps = 1;
+};
+
+/// The physical data of one joint as the MuJoCo plant uses it: from the file's "dynamics" when
+/// given, else from its RCU block ("hardware": the Microbo), else defaults (below).
+struct JointPlant {
+  double inertia = 0.0;     ///< effective inertia at the joint (the motor's), kg m^2 or kg
+  double viscous = 0.0;     ///< N m s/rad or N s/m
+  double coulomb = 0.0;     ///< N m or N
+  double max_effort = 0.0;  ///< N m or N
+  double bandwidth = 0.0;   ///< the servo's closed-loop poles, rad/s
+};
+
+/// Defaults for a joint the file says nothing about: a stiff servo, no friction.
+inline constexpr double kDefaultInertia_kg_m2 = 1.0;
+inline constexpr double kDefaultInertia_kg = 10.0;
+inline constexpr double kDefaultMaxEffort_N_m = 200.0;
+inline constexpr double kDefaultMaxEffort_N = 1000.0;
+/// The servo bandwidth when the file gives none (SimulatedPuma's), rad/s.
+inline constexpr double kDefaultServoBandwidth_rad_per_s = 40.0;
+/// A link whose mass the file does not give weighs this much, kg.
+inline constexpr double kDefaultLinkMass_kg = 1.0;
+/// Links' inertia tensors are not in the robot files: each link is taken as a solid sphere of
+/// this radius about its centre of mass (the joints' armature, the motors' inertia, dominates).
+inline constexpr double kLinkGyrationSphere_m = 0.05;
+/// The radius of the arm links' capsules, m.
+inline constexpr double kLinkRadius_m = 0.03;
+
+/// Every joint's plant data (model.dof() of them). Throws std::invalid_argument for a bad RCU
+/// block.
+std::array<JointPlant, kin::kMaxJoints> joint_plants(const kin::RobotModel& model);
+
+/// The MJCF of `model` in `scene`. Names: bodies "base", "link1" .. "link<dof>", "tool", the
+/// boxes' names; joints "j1" ...; motors "m1" ...; sites "t6" (T6) and "ft" (the sensor, at T6
+/// on the tool body); sensors "ft_force" and "ft_torque". Throws std::invalid_argument for a
+/// box without a usable name or size, or substeps < 1.
+std::string make_mjcf(const kin::RobotModel& model, const Scene& scene = {});
+
+}  // namespace rccx::hw
