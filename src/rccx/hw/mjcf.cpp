@@ -117,6 +117,12 @@ std::string make_mjcf(const kin::RobotModel& model, const Scene& scene) {
     throw std::invalid_argument(
         fmt::format("scene: {} MuJoCo steps a servo tick; give 1 to 100", scene.substeps));
   }
+  if (!(scene.contact_time_constant_s >= 2.0 * kServoPeriod_s / scene.substeps) ||
+      !std::isfinite(scene.contact_time_constant_s)) {
+    throw std::invalid_argument(fmt::format(
+        "scene: the contact time constant must be at least two MuJoCo steps ({} s), got {} s",
+        2.0 * kServoPeriod_s / scene.substeps, scene.contact_time_constant_s));
+  }
   if (!(scene.tool_mass_kg >= 0) || !(scene.tool_length_m >= 0) || !(scene.tool_radius_m > 0)) {
     throw std::invalid_argument("scene: the tool's mass, length and radius must not be negative");
   }
@@ -126,7 +132,7 @@ std::string make_mjcf(const kin::RobotModel& model, const Scene& scene) {
           "scene: box name \"{}\": use 1 to 64 letters, digits and underscores", b.name));
     }
     if (!(b.half_size_m.x > 0 && b.half_size_m.y > 0 && b.half_size_m.z > 0) || !(b.mass_kg >= 0) ||
-        !(b.friction >= 0)) {
+        !(b.friction >= 0) || !(scene.tool_friction >= 0)) {
       throw std::invalid_argument(fmt::format(
           "scene: box {} needs half sizes > 0, a mass and friction not negative", b.name));
     }
@@ -144,10 +150,11 @@ std::string make_mjcf(const kin::RobotModel& model, const Scene& scene) {
       "\n",
       num(timestep), num(-kGravity_m_per_s2));
   x += "  <size nconmax=\"200\" njmax=\"600\"/>\n";
-  // Contact: stiff (a 2 ms time constant, critically damped; the safe minimum at 1 ms is 2
-  // steps), hard impedance, three-dimensional friction cones.
+  // Contact: critically damped with the scene's time constant (at least 2 steps), hard
+  // impedance, three-dimensional friction cones.
   x += "  <default>\n";
-  x += "    <geom condim=\"3\" solref=\"0.002 1\" solimp=\"0.95 0.99 0.001\"/>\n";
+  x += fmt::format("    <geom condim=\"3\" solref=\"{} 1\" solimp=\"0.95 0.99 0.001\"/>\n",
+                   num(scene.contact_time_constant_s));
   x += "    <joint limited=\"true\" solreflimit=\"0.004 1\"/>\n";
   x += "  </default>\n";
   x += "  <worldbody>\n";
@@ -248,14 +255,14 @@ std::string make_mjcf(const kin::RobotModel& model, const Scene& scene) {
   indent(x, depth);
   if (axis_end < 1e-6) {
     x += fmt::format(
-        R"(<geom name="tool" type="sphere" size="{}" pos="0 0 {}" friction="0.5 0.005 0.0001" contype="2" conaffinity="1"/>)"
+        R"(<geom name="tool" type="sphere" size="{}" pos="0 0 {}" friction="{} 0.005 0.0001" contype="2" conaffinity="1"/>)"
         "\n",
-        num(r), num(axis_end));
+        num(r), num(axis_end), num(scene.tool_friction));
   } else {
     x += fmt::format(
-        R"(<geom name="tool" type="capsule" size="{}" fromto="0 0 0 0 0 {}" friction="0.5 0.005 0.0001" contype="2" conaffinity="1"/>)"
+        R"(<geom name="tool" type="capsule" size="{}" fromto="0 0 0 0 0 {}" friction="{} 0.005 0.0001" contype="2" conaffinity="1"/>)"
         "\n",
-        num(r), num(axis_end));
+        num(r), num(axis_end), num(scene.tool_friction));
   }
   --depth;
   indent(x, depth);

@@ -47,8 +47,14 @@ struct Scene {
   /// tool_radius_m) can touch; 0: a sphere of that radius at T6.
   double tool_length_m = 0.0;
   double tool_radius_m = 0.01;
+  /// The tool's sliding friction coefficient (MuJoCo takes the larger of the two in a contact).
+  double tool_friction = 0.5;
   /// MuJoCo steps per 1 ms servo tick (the time step is 1 ms / substeps).
   int substeps = 1;
+  /// How stiff contact is: MuJoCo's solref time constant, s (critically damped; at least two
+  /// steps). 2 ms is steel on steel; force control through position servos sampled at 10 ms
+  /// wants a tool with some give (a rubber tip, a compliance device): 20 ms, MuJoCo's default.
+  double contact_time_constant_s = 0.002;
 };
 
 /// The physical data of one joint as the MuJoCo plant uses it: from the file's "dynamics" when

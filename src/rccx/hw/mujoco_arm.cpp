@@ -80,7 +80,8 @@ MujocoArm::MujocoArm(kin::RobotModel model, const SimulatedArmOptions& options)
   jacp_.assign(3 * static_cast<std::size_t>(m_->nv), 0.0);
   jacr_.assign(3 * static_cast<std::size_t>(m_->nv), 0.0);
   write_state();
-  mj_forward(m_, d_);  // sensors and poses valid before the first tick
+  mj_forward(m_, d_);                     // sensors and poses valid before the first tick
+  filtered_wrench_ = raw_wrist_wrench();  // the filter starts settled
 }
 
 MujocoArm::~MujocoArm() {
@@ -180,13 +181,21 @@ void MujocoArm::servo_tick(double dt) noexcept {
     clamp_to_stops(s);
   }
   write_state();
+  // The sensor's own low-pass filter (a first-order one, as strain-gauge electronics filter
+  // before sampling): contact forces in MuJoCo come as impulses within single steps.
+  const math::Wrench raw = raw_wrist_wrench();
+  const double a = dt / (kSensorFilter_s + dt);
+  filtered_wrench_ = filtered_wrench_ + (raw - filtered_wrench_) * a;
+}
+
+math::Wrench MujocoArm::raw_wrist_wrench() const noexcept {
+  const mjtNum* f = d_->sensordata + force_adr_;
+  const mjtNum* t = d_->sensordata + torque_adr_;
+  return {{-f[0], -f[1], -f[2]}, {-t[0], -t[1], -t[2]}};
 }
 
 bool MujocoArm::wrist_wrench(math::Wrench& w) const noexcept {
-  const mjtNum* f = d_->sensordata + force_adr_;
-  const mjtNum* t = d_->sensordata + torque_adr_;
-  w.force_N = {-f[0], -f[1], -f[2]};
-  w.torque_N_m = {-t[0], -t[1], -t[2]};
+  w = filtered_wrench_;
   return true;
 }
 

@@ -61,6 +61,11 @@ class MujocoArm final : public ArmBase {
   /// sensor "ft" of the last step, sign-turned (MuJoCo's force sensor gives the force the
   /// parent body exerts on the tool body).
   [[nodiscard]] bool wrist_wrench(math::Wrench& w) const noexcept override;
+  /// The sensor's electronics filter the load with this time constant before it is read, s
+  /// (a 16 Hz first-order low-pass): MuJoCo's contact forces come as impulses within steps.
+  static constexpr double kSensorFilter_s = 0.03;
+  /// The load of the last step, unfiltered (N, N m; as wrist_wrench).
+  [[nodiscard]] math::Wrench raw_wrist_wrench() const noexcept;
 
   [[nodiscard]] const std::string& mjcf() const noexcept { return mjcf_; }
   [[nodiscard]] const Scene& scene() const noexcept { return scene_; }
@@ -112,6 +117,7 @@ class MujocoArm final : public ArmBase {
   std::array<double, kin::kMaxJoints> integral_{};
   std::array<double, kin::kMaxJoints> tau_{};
   int force_adr_ = 0, torque_adr_ = 0;  ///< the sensors' places in sensordata
+  math::Wrench filtered_wrench_;        ///< wrist_wrench: the filtered load
 };
 
 }  // namespace rccx::hw
