@@ -49,13 +49,15 @@ struct Deadline {
 };
 
 /// Joint goals around the ready pose, within the limits: a demonstration the view can follow.
-std::vector<kin::JointVector> sweep(const kin::RobotModel& m) {
+/// `from` > 0: only joints from there on move (the wrists of robots that share a cell, so that
+/// their sweeps keep apart).
+std::vector<kin::JointVector> sweep(const kin::RobotModel& m, std::size_t from = 0) {
   std::vector<kin::JointVector> goals;
   const kin::JointVector ready = m.ready();
   const double amplitude[] = {0.35, -0.35, 0.2, -0.2};
   for (double a : amplitude) {
     kin::JointVector q = ready;
-    for (std::size_t i = 0; i < m.dof(); ++i) {
+    for (std::size_t i = from; i < m.dof(); ++i) {
       const kin::Joint& j = m.joints[i];
       const double span = j.upper - j.lower;
       const double step = j.type == kin::JointType::prismatic ? 0.15 * span : a;
@@ -145,7 +147,7 @@ int run_cell(const ViewArgs& a) {
   for (const cell::CellRobot& r : model.robots) {
     c.robot(r.name).set_velocity(0.05, 0.3);
     std::vector<rccl::PositionPtr> p;
-    for (const kin::JointVector& q : sweep(r.model)) {
+    for (const kin::JointVector& q : sweep(r.model, 3)) {
       p.push_back(rccl::Position::joints(fmt::format("{}_P{}", r.name, p.size() + 1), q));
     }
     positions.push_back(std::move(p));
@@ -159,13 +161,20 @@ int run_cell(const ViewArgs& a) {
       gates.push_back(c.event(model.robots[r].name, m.end()));
     }
     const rccl::WaitResult w = c.waitfor(gates, std::chrono::seconds(60));
-    if (w != rccl::WaitResult::reached) {
-      if (io::stop_count() == 0) {
-        io::eprint("rccx view: the cell stopped: {}\n", rccl::to_string(w));
-        return kFailure;
+    if (w == rccl::WaitResult::reached) continue;
+    if (io::stop_count() > 0) break;
+    io::eprint("rccx view: the cell: {}\n", rccl::to_string(w));
+    bool ended = false;
+    for (const cell::CellRobot& r : model.robots) {
+      const rtc::Termination t = c.session(r.name).termination();
+      if (t.ended()) io::eprint("  {}: {}\n", r.name, rtc::describe(t.code));
+      ended = ended || t.ended();
+      for (const rccl::MotionEvent& f : c.robot(r.name).failures()) {
+        io::eprint("  {}: motion {}: {}\n", r.name, f.id, f.message());
       }
-      break;
     }
+    // A collision stop is the cell's check at work: the sweep goes on. Control that ended does not.
+    if (ended || w == rccl::WaitResult::session_ended) return kFailure;
     if (a.simulated_time) std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
   return kOk;
