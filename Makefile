@@ -32,7 +32,7 @@ build-release: deps $(RELEASE_DIR)/CMakeCache.txt
 demo: build-release
 	$(RELEASE_DIR)/examples/04_washer
 
-# The washer in real time with the view on: open the address it prints; Ctrl-C ends it.
+# The washer at the pace of the wall clock with the view on: open the address it prints; Ctrl-C ends it.
 demo-view: build-release
 	$(RELEASE_DIR)/examples/04_washer --view
 

@@ -11,9 +11,9 @@
 // tool point strayed from the straight edge (outside the corner transitions).
 // Run: ./build/release/examples/04_washer          (examples/washer.c is the 1986 text in C)
 //
-// With --view[=PORT] (`make demo-view`) it runs in real time and serves the view (rccx::view)
-// on 127.0.0.1:PORT (8080): open the address it prints to watch the arm, the window's corners
-// B .. E, the tool path and the plots; it serves until Ctrl-C once the washer is done.
+// With --view[=PORT] (`make demo-view`) it runs at the pace of the wall clock and serves the view
+// (rccx::view) on 127.0.0.1:PORT (8080): open the address it prints to watch the arm, the window's
+// corners B .. E, the tool path and the plots; it serves until Ctrl-C once the washer is done.
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -51,10 +51,9 @@ int main(int argc, char** argv) {
   }
   const bool viewed = view_port >= 0;
   if (viewed) io::install_stop_handlers();
-  // The emulated RCU, 28 ms samples; in real time when watched, so that the eye can follow.
-  rtc::SimulatedRobotOptions options;
-  options.clock = viewed ? rtc::ClockKind::real_time : rtc::ClockKind::simulated;
-  rtc::SimulatedRobot robot(kin::builtin_robot("microbo"), options);
+  // The emulated RCU, 28 ms samples, in simulated time (deterministic; paced to the clock on the
+  // wall when watched, so that the eye can follow, see wait below).
+  rtc::SimulatedRobot robot(kin::builtin_robot("microbo"));
   rccl::Manipulator arm(*robot.session);
   std::unique_ptr<view::Server> view;
   if (viewed) {
@@ -81,14 +80,26 @@ int main(int argc, char** argv) {
     for (const auto& p : {p1, p2, p3, p4}) view->show(p);  // the corners, named
   }
 
+  // waitfor; when watched, simulated time goes at the wall clock's pace: a sample, then its period
+  // of sleep (real time would do as well on a quiet machine, but a busy one may overrun).
+  const auto wait = [&](const rccl::Event& event) {
+    if (!viewed) return arm.waitfor(event);
+    const auto period = robot.session->period();
+    for (;;) {
+      const rccl::WaitResult r = arm.waitfor(event, period);
+      if (r != rccl::WaitResult::timeout || io::stop_count() > 0) return r;
+      std::this_thread::sleep_for(period);
+    }
+  };
+
   arm.start();
   double tvel_mm = 100, rvel_deg = 100;
   arm.set_velocity(tvel_mm * 1e-3, math::deg_to_rad(rvel_deg));
   std::vector<rccl::Motion> motions;
   motions.push_back(arm.move(arm.park()));
-  arm.waitfor(motions.back().end());
+  wait(motions.back().end());
   motions.push_back(arm.move(p1));
-  arm.waitfor(motions.back().end());
+  wait(motions.back().end());
 
   arm.set_mode(rccl::Mode::cartesian);
   std::vector<double> round_speed;
@@ -100,11 +111,11 @@ int main(int argc, char** argv) {
     rvel_deg += 10;
     arm.set_velocity(tvel_mm * 1e-3, math::deg_to_rad(rvel_deg));
   }
-  const rccl::WaitResult w = arm.waitfor(arm.completed());
+  const rccl::WaitResult w = wait(arm.completed());
 
   arm.set_mode(rccl::Mode::joint);
   motions.push_back(arm.move(arm.park()));
-  arm.waitfor(motions.back().end());
+  wait(motions.back().end());
   const rtc::Termination t = arm.stop_control();
 
   fmt::print(

@@ -147,7 +147,7 @@ TEST(ViewServer, WebSocketSendsHistoryThenLiveSamples) {
   const json history = json::parse(beast::buffers_to_string(buffer.data()));
   EXPECT_EQ(history["type"], "frames");
   EXPECT_TRUE(history["history"].get<bool>());
-  EXPECT_GE(history["frames"].size(), 45U);
+  EXPECT_GE(history["frames"].size(), 3U);  // simulated time: a few a server tick
   EXPECT_EQ(history["frames"][0]["q"].size(), 6U);
   EXPECT_EQ(history["frames"][0]["p"].size(), 3U);
 

@@ -9,6 +9,9 @@
 // own thread (Boost.Beast over Boost.Asio, one io_context) drains the queues at the same rate,
 // computes the tool frame, keeps a history for pages that open late, and sends each page the new
 // samples over a WebSocket; a page that cannot keep up loses samples, never slows anyone else.
+// In simulated time, which runs many times faster than the wall clock, at most 3 samples a
+// robot go on per tick (evenly spaced, the newest among them): the server's work stays that of
+// real time, and so does what it takes from the processors the loop runs on.
 //
 // HTTP, GET only (anything else: 405, the view is read-only):
 //   /                  the page, every robot           /robot/NAME   the page, one robot
