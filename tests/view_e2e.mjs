@@ -146,7 +146,7 @@ try {
   // --- 2. Replay ----------------------------------------------------------------------------
   const csv = join(artifacts, 'view-run.csv');
   const rec = await new Promise((resolve) => {
-    const p = spawn(rccx, ['view', '--robot', 'microbo', '--port', '0', '--simulated-time', '--seconds', '1.5'],
+    const p = spawn(rccx, ['view', '--robot', 'microbo', '--port', '0', '--fast', '--seconds', '1.5'],
       { env: { ...process.env, RCCX_LOG: csv }, stdio: 'inherit' });
     p.on('exit', resolve);
   });

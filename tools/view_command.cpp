@@ -30,7 +30,7 @@ struct ViewArgs {
   int port = 8080;
   double seconds = 0.0;
   double rate_hz = 50.0;
-  bool simulated_time = false;
+  bool fast = false;  ///< simulated time as fast as the machine goes (else paced to the clock)
 };
 
 using Clock = std::chrono::steady_clock;
@@ -99,9 +99,8 @@ int run_replay(const ViewArgs& a) {
 
 int run_robot(const ViewArgs& a) {
   const kin::RobotModel model = a.robot.model();
-  rtc::SimulatedRobotOptions options;
-  options.clock = a.simulated_time ? rtc::ClockKind::simulated : rtc::ClockKind::real_time;
-  rtc::SimulatedRobot robot(model, options);
+  // Simulated time (deterministic, and no overrun on a busy machine), paced to the wall clock.
+  rtc::SimulatedRobot robot(model);
   rccl::Manipulator arm(*robot.session);
   const auto server =
       view::serve(*robot.session, static_cast<std::uint16_t>(a.port), serve_options(a));
@@ -117,7 +116,14 @@ int run_robot(const ViewArgs& a) {
   int code = kOk;
   for (std::size_t i = 0; !deadline.over(); i = (i + 1) % positions.size()) {
     const rccl::Motion m = arm.move(positions[i]);
-    const rccl::WaitResult w = arm.waitfor(m.end(), std::chrono::seconds(60));
+    rccl::WaitResult w = rccl::WaitResult::timeout;
+    const auto period = robot.session->period();
+    for (int k = 0; k < 100000 && w == rccl::WaitResult::timeout && !deadline.over(); ++k) {
+      w = arm.waitfor(m.end(),
+                      a.fast ? std::chrono::nanoseconds(std::chrono::seconds(60)) : period);
+      if (w == rccl::WaitResult::timeout && !a.fast) std::this_thread::sleep_for(period);
+    }
+    if (w == rccl::WaitResult::timeout) break;
     if (w == rccl::WaitResult::session_ended || w == rccl::WaitResult::failed) {
       if (io::stop_count() == 0) {
         io::eprint("rccx view: the robot stopped: {}\n", rccl::to_string(w));
@@ -125,7 +131,6 @@ int run_robot(const ViewArgs& a) {
       }
       break;
     }
-    if (a.simulated_time) std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
   (void)arm.stop_control();
   return code;
@@ -138,9 +143,7 @@ int run_cell(const ViewArgs& a) {
   } catch (const cell::CellFileError& e) {
     throw BadArgument{e.what()};
   }
-  cell::CellOptions options;
-  options.clock = a.simulated_time ? rtc::ClockKind::simulated : rtc::ClockKind::real_time;
-  cell::Cell c(model, options);
+  cell::Cell c(model);  // simulated time, paced to the wall clock as run_robot's
   c.start();
   const auto server = view::serve(c, static_cast<std::uint16_t>(a.port), serve_options(a));
   std::vector<std::vector<rccl::PositionPtr>> positions;
@@ -160,7 +163,13 @@ int run_cell(const ViewArgs& a) {
       const rccl::Motion m = c.robot(model.robots[r].name).move(p[i % p.size()]);
       gates.push_back(c.event(model.robots[r].name, m.end()));
     }
-    const rccl::WaitResult w = c.waitfor(gates, std::chrono::seconds(60));
+    rccl::WaitResult w = rccl::WaitResult::timeout;
+    const auto tick = c.group().period();
+    for (int k = 0; k < 100000 && w == rccl::WaitResult::timeout && !deadline.over(); ++k) {
+      w = c.waitfor(gates, a.fast ? std::chrono::nanoseconds(std::chrono::seconds(60)) : tick);
+      if (w == rccl::WaitResult::timeout && !a.fast) std::this_thread::sleep_for(tick);
+    }
+    if (w == rccl::WaitResult::timeout) break;
     if (w == rccl::WaitResult::reached) continue;
     if (io::stop_count() > 0) break;
     io::eprint("rccx view: the cell: {}\n", rccl::to_string(w));
@@ -175,7 +184,6 @@ int run_cell(const ViewArgs& a) {
     }
     // A collision stop is the cell's check at work: the sweep goes on. Control that ended does not.
     if (ended || w == rccl::WaitResult::session_ended) return kFailure;
-    if (a.simulated_time) std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
   return kOk;
 }
@@ -222,8 +230,9 @@ void add_view_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--seconds", args->seconds, "Stop after this many seconds (0: at Ctrl-C)")
       ->check(CLI::Range(0.0, 1e6))
       ->capture_default_str();
-  cmd->add_flag("--simulated-time", args->simulated_time,
-                "Run the robot in simulated time (as fast as the machine goes; for tests)");
+  cmd->add_flag("--fast", args->fast,
+                "Run simulated time as fast as the machine goes (default: at the clock's pace); "
+                "with RCCX_LOG=FILE, a quick way to record a run");
   cmd->callback([args, &exit_code] { guarded(exit_code, [&] { return run_view(*args); }); });
 }
 
