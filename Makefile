@@ -9,7 +9,7 @@ FUZZ_DIR := build/fuzz
 # Seconds all fuzz targets get together in `make test` (scripts/fuzz shares them out).
 FUZZ_SECONDS ?= 60
 
-.PHONY: all deps demo demo-cell test unit-tests fuzz tsan bench bench-cell build-debug build-release format format-check clean
+.PHONY: all deps demo demo-view demo-cell test unit-tests fuzz tsan bench bench-cell build-debug build-release format format-check clean
 
 all: build-release
 
@@ -31,6 +31,10 @@ build-release: deps $(RELEASE_DIR)/CMakeCache.txt
 # The main example: the thesis's window washer in RCCL motion equations, on the simulated Microbo.
 demo: build-release
 	$(RELEASE_DIR)/examples/04_washer
+
+# The washer at the pace of the wall clock with the view on: open the address it prints; Ctrl-C ends it.
+demo-view: build-release
+	$(RELEASE_DIR)/examples/04_washer --view
 
 # The two-robot demo on the CVaRL cell: the PUMA presents a circuit board, the Microbo probes it.
 demo-cell: build-release

@@ -10,21 +10,60 @@
 // It prints what the arm did: each segment's times, and how far the commanded and the measured
 // tool point strayed from the straight edge (outside the corner transitions).
 // Run: ./build/release/examples/04_washer          (examples/washer.c is the 1986 text in C)
+//
+// With --view[=PORT] (`make demo-view`) it runs at the pace of the wall clock and serves the view
+// (rccx::view) on 127.0.0.1:PORT (8080): open the address it prints to watch the arm, the window's
+// corners B .. E, the tool path and the plots; it serves until Ctrl-C once the washer is done.
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cstring>
+#include <memory>
+#include <thread>
 #include <vector>
 
+#include "rccx/io/parse.hpp"
+#include "rccx/io/signals.hpp"
 #include "rccx/math/units.hpp"
 #include "rccx/rccl/manipulator.hpp"
 #include "rccx/rtc/simulated_robot.hpp"
+#include "rccx/view/server.hpp"
 
 using namespace rccx;
 using namespace rccx::math::literals;
 
-int main() {
-  rtc::SimulatedRobot robot(kin::builtin_robot("microbo"));  // the emulated RCU, 28 ms samples
+int main(int argc, char** argv) {
+  int view_port = -1;  // no view
+  for (int i = 1; i < argc; ++i) {
+    const std::string_view arg = argv[i];
+    try {
+      if (arg == "--view") {
+        view_port = 8080;
+      } else if (arg.starts_with("--view=")) {
+        view_port = static_cast<int>(io::parse_integer(arg.substr(7), "--view", 0, 65535));
+      } else {
+        throw io::ParseError(fmt::format("unknown argument {}", io::quoted(arg)));
+      }
+    } catch (const io::ParseError& e) {
+      fmt::print(stderr, "04_washer: {}; usage: 04_washer [--view[=PORT]]\n", e.what());
+      return 2;
+    }
+  }
+  const bool viewed = view_port >= 0;
+  if (viewed) io::install_stop_handlers();
+  // The emulated RCU, 28 ms samples, in simulated time (deterministic; paced to the clock on the
+  // wall when watched, so that the eye can follow, see wait below).
+  rtc::SimulatedRobot robot(kin::builtin_robot("microbo"));
   rccl::Manipulator arm(*robot.session);
+  std::unique_ptr<view::Server> view;
+  if (viewed) {
+    try {
+      view = view::serve(*robot.session, static_cast<std::uint16_t>(view_port));
+    } catch (const view::ViewError& e) {
+      fmt::print(stderr, "04_washer: {}\n", e.what());
+      return 2;
+    }
+  }
 
   // Translations from the robot's origin to the 4 corners; the tool points at the table.
   const auto corner = [](const char* name, double y_mm, double z_mm) {
@@ -37,15 +76,30 @@ int main() {
   const auto p2 = rccl::Position::make("P2", {t6}, {c}, t6);
   const auto p3 = rccl::Position::make("P3", {t6}, {d}, t6);
   const auto p4 = rccl::Position::make("P4", {t6}, {e}, t6);
+  if (view) {
+    for (const auto& p : {p1, p2, p3, p4}) view->show(p);  // the corners, named
+  }
+
+  // waitfor; when watched, simulated time goes at the wall clock's pace: a sample, then its period
+  // of sleep (real time would do as well on a quiet machine, but a busy one may overrun).
+  const auto wait = [&](const rccl::Event& event) {
+    if (!viewed) return arm.waitfor(event);
+    const auto period = robot.session->period();
+    for (;;) {
+      const rccl::WaitResult r = arm.waitfor(event, period);
+      if (r != rccl::WaitResult::timeout || io::stop_count() > 0) return r;
+      std::this_thread::sleep_for(period);
+    }
+  };
 
   arm.start();
   double tvel_mm = 100, rvel_deg = 100;
   arm.set_velocity(tvel_mm * 1e-3, math::deg_to_rad(rvel_deg));
   std::vector<rccl::Motion> motions;
   motions.push_back(arm.move(arm.park()));
-  arm.waitfor(motions.back().end());
+  wait(motions.back().end());
   motions.push_back(arm.move(p1));
-  arm.waitfor(motions.back().end());
+  wait(motions.back().end());
 
   arm.set_mode(rccl::Mode::cartesian);
   std::vector<double> round_speed;
@@ -57,11 +111,11 @@ int main() {
     rvel_deg += 10;
     arm.set_velocity(tvel_mm * 1e-3, math::deg_to_rad(rvel_deg));
   }
-  const rccl::WaitResult w = arm.waitfor(arm.completed());
+  const rccl::WaitResult w = wait(arm.completed());
 
   arm.set_mode(rccl::Mode::joint);
   motions.push_back(arm.move(arm.park()));
-  arm.waitfor(motions.back().end());
+  wait(motions.back().end());
   const rtc::Termination t = arm.stop_control();
 
   fmt::print(
@@ -100,9 +154,12 @@ int main() {
   for (const rccl::MotionEvent& f : arm.failures()) {
     fmt::print(stderr, "motion {} {}: {}\n", f.id, rccl::to_string(f.kind), f.message());
   }
-  if (w != rccl::WaitResult::reached || t.ended() || !arm.failures().empty()) {
-    rtc::print_terminate_code(t, stderr);
-    return 1;
+  const bool failed = w != rccl::WaitResult::reached || t.ended() || !arm.failures().empty();
+  if (failed) rtc::print_terminate_code(t, stderr);
+  if (view && io::stop_count() == 0) {
+    fmt::print("\nthe view stays at {} until Ctrl-C\n", view->url());
+    std::fflush(stdout);
+    while (io::stop_count() == 0) std::this_thread::sleep_for(std::chrono::milliseconds(100));
   }
-  return 0;
+  return failed ? 1 : 0;
 }

@@ -9,11 +9,13 @@
 #include "cli_common.hpp"
 #include "db_command.hpp"
 #include "kin_command.hpp"
+#include "plot_command.hpp"
 #include "rccx/io/console.hpp"
 #include "rccx/io/signals.hpp"
 #include "rcu_command.hpp"
 #include "rtc_commands.hpp"
 #include "teach_command.hpp"
+#include "view_command.hpp"
 
 namespace {
 
@@ -41,6 +43,8 @@ int run(int argc, char** argv) {
   rccx::tools::add_db_command(app, exit_code);
   rccx::tools::add_teach_command(app, exit_code);
   rccx::tools::add_cell_command(app, exit_code);
+  rccx::tools::add_view_command(app, exit_code);
+  rccx::tools::add_plot_command(app, exit_code);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -24,6 +24,7 @@
 
 #include "rccx/io/file.hpp"
 #include "rccx/kinematics/kinematics.hpp"
+#include "rccx/rtc/types.hpp"
 
 namespace rccx::rtc {
 
@@ -38,6 +39,18 @@ struct LogRow {
   std::int32_t segment = 0;
   kin::JointVector commanded;  ///< rad or m
   kin::JointVector measured;   ///< rad or m
+};
+
+/// A second consumer of the controlled samples, beside the log: what rccx::view taps the loop
+/// with. The communication task calls on_sample once a controlled sample, after the Chg was
+/// applied, with the How it read and the joints it commanded (rad / m; the measured value for a
+/// joint not commanded yet). It must return at once: no lock, no allocation, no exception (push
+/// into a lock-free buffer and return, as SampleLog::push does).
+class SampleTap {
+ public:
+  virtual ~SampleTap() = default;
+  virtual void on_sample(const How& how, const kin::JointVector& commanded,
+                         std::int32_t segment) noexcept = 0;
 };
 
 class SampleLog {

@@ -193,6 +193,8 @@ struct Session::Shared {
   std::atomic<std::int32_t> requested_code{0};
   std::atomic<std::int32_t> requested_joint{0};
   std::atomic<SampleLog*> log{nullptr};
+  std::atomic<SampleTap*> tap{nullptr};
+  std::atomic<bool> tap_busy{false};  ///< the communication task is in (or about to call) the tap
 
   // Each task's own on lines of their own (with two tasks they run on two processors).
   alignas(64) CommState comm;   ///< the communication task's own
@@ -531,6 +533,12 @@ How Session::how() const {
 
 LatencyStats Session::latency() const {
   return clock_->latency.stats();
+}
+
+void Session::set_tap(SampleTap* tap) noexcept {
+  shared_->tap.store(tap);
+  if (tap != nullptr) return;
+  while (shared_->tap_busy.load()) std::this_thread::yield();
 }
 
 void Session::set_log(SampleLog* log) {
@@ -1016,6 +1024,19 @@ void Session::apply_taken(CommState& c) noexcept {
       if (c.has_target[i]) row.commanded[i] = c.last_target[i];
     }
     log->push(row);
+  }
+  if (s.tap.load(std::memory_order_relaxed) != nullptr) {
+    // set_tap(nullptr) waits while tap_busy: busy is raised before the pointer is read again
+    // (sequentially consistent, as the detaching side's store and load are).
+    s.tap_busy.store(true);
+    if (SampleTap* tap = s.tap.load()) {
+      JointVector commanded = h.q();
+      for (std::size_t i = 0; i < h.dof; ++i) {
+        if (c.has_target[i]) commanded[i] = c.last_target[i];
+      }
+      tap->on_sample(h, commanded, c.chg.segment);
+    }
+    s.tap_busy.store(false, std::memory_order_release);
   }
 }
 

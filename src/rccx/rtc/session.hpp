@@ -173,6 +173,11 @@ class Session {
   /// tool pose); nullptr stops. Only while not in control. Without a call, a session logs to
   /// the file named by the environment variable RCCX_LOG, if any.
   void set_log(SampleLog* log);
+  /// Calls `tap` every controlled sample from the communication task (the view's tap, see
+  /// SampleTap); nullptr stops. Any time, from the planning level: a tap set while in control
+  /// sees the next sample; set_tap(nullptr) returns once the communication task is out of the
+  /// last call, so the tap may be destroyed then. One tap a session.
+  void set_tap(SampleTap* tap) noexcept;
   /// Wake-up latency of the communication task (real time only).
   [[nodiscard]] LatencyStats latency() const;
 

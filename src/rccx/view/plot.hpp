@@ -1,0 +1,17 @@
+// `rccx plot`: the standard plots of a recorded run as one SVG, for reports and docs, without a
+// browser: the joints (commanded and measured), the tool path in the plane it moves in most,
+// the speed along the path, and the path error (the measured tool from the commanded path).
+#pragma once
+
+#include <string>
+
+#include "rccx/kinematics/robot_model.hpp"
+#include "rccx/view/run_log.hpp"
+
+namespace rccx::view {
+
+/// The SVG document (about 1200 x 900 px). `title` heads it. RunLogError when the log's joints
+/// do not match the robot's.
+std::string plot_svg(const RunLog& log, const kin::RobotModel& model, const std::string& title);
+
+}  // namespace rccx::view

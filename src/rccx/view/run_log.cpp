@@ -1,0 +1,116 @@
+#include "rccx/view/run_log.hpp"
+
+#include <fmt/format.h>
+
+#include "rccx/io/file.hpp"
+#include "rccx/io/parse.hpp"
+
+namespace rccx::view {
+
+namespace {
+
+std::vector<std::string_view> split(std::string_view line) {
+  std::vector<std::string_view> cells;
+  std::size_t start = 0;
+  for (;;) {
+    const std::size_t comma = line.find(',', start);
+    cells.push_back(
+        line.substr(start, comma == std::string_view::npos ? line.npos : comma - start));
+    if (comma == std::string_view::npos) return cells;
+    start = comma + 1;
+  }
+}
+
+constexpr std::string_view kExpected =
+    "a log rccx writes (--log FILE or RCCX_LOG=FILE): t,seg,q1..qN,qm1..qmN,x,y,z,ax,ay,az";
+
+}  // namespace
+
+RunLog parse_run_log(std::string_view text, std::string_view origin) {
+  RunLog log;
+  std::size_t line_no = 0;
+  std::size_t pos = 0;
+  std::vector<std::string> header;
+  while (pos < text.size()) {
+    std::size_t end = text.find('\n', pos);
+    if (end == std::string_view::npos) end = text.size();
+    std::string_view line = text.substr(pos, end - pos);
+    pos = end + 1;
+    ++line_no;
+    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+    const auto cells = split(line);
+    if (line_no == 1) {
+      if (!io::is_utf8(line) || cells.size() < 2 + 2 + 6 || cells[0] != "t" || cells[1] != "seg" ||
+          (cells.size() - 8) % 2 != 0) {
+        throw RunLogError(fmt::format("{}:1: the header {} is not {}", origin,
+                                      io::quoted(line.substr(0, 80)), kExpected));
+      }
+      log.dof = (cells.size() - 8) / 2;
+      if (log.dof > kin::kMaxJoints) {
+        throw RunLogError(
+            fmt::format("{}:1: {} joints; rccx logs at most {}", origin, log.dof, kin::kMaxJoints));
+      }
+      for (std::size_t i = 1; i <= log.dof; ++i) header.push_back(fmt::format("q{}", i));
+      for (std::size_t i = 1; i <= log.dof; ++i) header.push_back(fmt::format("qm{}", i));
+      for (const char* c : {"x", "y", "z", "ax", "ay", "az"}) header.emplace_back(c);
+      for (std::size_t i = 0; i < header.size(); ++i) {
+        if (cells[i + 2] != header[i]) {
+          throw RunLogError(fmt::format("{}:1: column {} is {}, expected {}: not {}", origin, i + 3,
+                                        io::quoted(cells[i + 2].substr(0, 40)), header[i],
+                                        kExpected));
+        }
+      }
+      continue;
+    }
+    if (line.empty() && pos >= text.size()) break;  // the final newline
+    if (cells.size() != header.size() + 2) {
+      throw RunLogError(fmt::format("{}:{}: {} columns, the header has {}", origin, line_no,
+                                    cells.size(), header.size() + 2));
+    }
+    RunRow row;
+    const auto number = [&](std::size_t column, std::string_view name) {
+      try {
+        return io::parse_number(cells[column], name);
+      } catch (const io::ParseError& e) {
+        throw RunLogError(
+            fmt::format("{}:{}: column {} ({}): {}", origin, line_no, column + 1, name, e.what()));
+      }
+    };
+    row.t_s = number(0, "t");
+    try {
+      row.segment = static_cast<std::int32_t>(io::parse_integer(cells[1], "seg", 0, INT32_MAX));
+    } catch (const io::ParseError& e) {
+      throw RunLogError(fmt::format("{}:{}: column 2 (seg): {}", origin, line_no, e.what()));
+    }
+    row.commanded = kin::JointVector(log.dof);
+    row.measured = kin::JointVector(log.dof);
+    for (std::size_t i = 0; i < log.dof; ++i) {
+      row.commanded[i] = number(2 + i, header[i]);
+      row.measured[i] = number(2 + log.dof + i, header[log.dof + i]);
+    }
+    for (std::size_t k = 0; k < 3; ++k) {
+      row.p[k] = number(2 + 2 * log.dof + k, header[2 * log.dof + k]);
+      row.a[k] = number(5 + 2 * log.dof + k, header[2 * log.dof + 3 + k]);
+    }
+    if (!log.rows.empty() && row.t_s <= log.rows.back().t_s) {
+      throw RunLogError(fmt::format("{}:{}: column 1 (t): time {} does not follow {}", origin,
+                                    line_no, row.t_s, log.rows.back().t_s));
+    }
+    log.rows.push_back(row);
+  }
+  if (line_no == 0) throw RunLogError(fmt::format("{}: empty: not {}", origin, kExpected));
+  if (log.rows.empty()) throw RunLogError(fmt::format("{}: a header and no samples", origin));
+  return log;
+}
+
+RunLog load_run_log(const std::filesystem::path& file) {
+  std::string text;
+  try {
+    text = io::read_file(file);
+  } catch (const std::exception& e) {
+    throw RunLogError(fmt::format("cannot read the log: {}", e.what()));
+  }
+  return parse_run_log(text, file.string());
+}
+
+}  // namespace rccx::view

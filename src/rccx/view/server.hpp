@@ -1,0 +1,118 @@
+// `rccx view`: a read-only web page of robots at work, served from the program that drives them.
+//
+//   auto view = rccx::view::serve(*robot.session, 8080);   // prints http://127.0.0.1:8080/
+//
+// The sample loop is tapped the way the CSV log is (rtc::Session::set_tap): the communication
+// task copies a fixed-size sample into a lock-free single-producer queue every 1/rate s of
+// sample time (decimated in the loop, so the copy costs nothing the other samples) and returns;
+// it never waits, locks or allocates, and a full queue drops the sample (counted). The server's
+// own thread (Boost.Beast over Boost.Asio, one io_context) drains the queues at the same rate,
+// computes the tool frame, keeps a history for pages that open late, and sends each page the new
+// samples over a WebSocket; a page that cannot keep up loses samples, never slows anyone else.
+// In simulated time, which runs many times faster than the wall clock, at most 3 samples a
+// robot go on per tick (evenly spaced, the newest among them): the server's work stays that of
+// real time, and so does what it takes from the processors the loop runs on.
+//
+// HTTP, GET only (anything else: 405, the view is read-only):
+//   /                  the page, every robot           /robot/NAME   the page, one robot
+//   /assets/FILE       the bundled front end (web/, built by the project's build)
+//   /api/scene         robots (DH chains, bases, tools, capsules), objects, frames (?robot=NAME)
+//   /api/state         the last sample of every robot; ?robot=NAME&t=T: that robot's at time T
+//   /api/log           replay only: the whole recorded run
+//   /ws                the live samples (?robot=NAME), as JSON text messages
+// An unknown robot is a 404 with a message naming the robots there; the server goes on.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <stdexcept>
+#include <string>
+
+#include "rccx/rccl/position.hpp"
+#include "rccx/view/run_log.hpp"
+#include "rccx/view/scene.hpp"
+
+namespace rccx::rtc {
+class Session;
+}
+namespace rccx::cell {
+class Cell;
+}
+
+namespace rccx::view {
+
+/// The view cannot start (a port in use, an address that cannot be bound, no front end).
+class ViewError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct ServeOptions {
+  /// The address to listen on: 127.0.0.1 unless asked (0.0.0.0 serves the network, read-only).
+  std::string address = "127.0.0.1";
+  /// Samples a second sent to the pages (the tap decimates to it), 1 .. 200.
+  double rate_hz = 50.0;
+  /// The bundled front end; empty: found beside the executable (see find_assets).
+  std::filesystem::path assets;
+  /// Samples kept for pages that open late (and /api/state?t=).
+  std::size_t history = 6000;
+  /// Say the address to open on stderr.
+  bool announce = true;
+};
+
+/// Where the front end the build made is: $RCCX_VIEW_ASSETS, else <exe>/../web/dist (the build
+/// tree: build/<type>/web/dist), <exe>/../share/rccx/web (an install), else the build tree
+/// configured in. Empty when none holds index.html.
+std::filesystem::path find_assets();
+
+struct ServerStats {
+  std::uint64_t samples_sent = 0;      ///< samples drained from the taps and broadcast
+  std::uint64_t samples_dropped = 0;   ///< by the taps (queue full)
+  std::uint64_t messages_dropped = 0;  ///< to pages that did not keep up
+  std::size_t pages = 0;               ///< WebSocket connections open now
+  std::uint64_t requests = 0;          ///< HTTP requests served
+};
+
+class Server {
+ public:
+  /// Listens on options.address:port (0: any free port) and starts the server's thread. Throws
+  /// ViewError for a port in use or an address that cannot be bound, saying what to do.
+  Server(Scene scene, std::uint16_t port, ServeOptions options = {});
+  /// Detaches every tap, then stops the server. Destroy it before the sessions it taps.
+  ~Server();
+  Server(const Server&) = delete;
+  Server& operator=(const Server&) = delete;
+
+  /// Taps `session` for scene robot `robot` (0-based). Planning level, any time.
+  void attach(std::size_t robot, rtc::Session& session);
+  /// Replay: the page gets `log` (robot 0) with a time slider instead of live samples.
+  void set_replay(RunLog log);
+  /// Draws a position equation's goal (the tool frame where the equation puts it, in the world)
+  /// with its name, for scene robot `robot`. Planning level.
+  void show(const rccl::PositionPtr& position, std::size_t robot = 0);
+  /// Adds a named frame (world <- frame). Planning level.
+  void add_frame(SceneFrame frame);
+
+  [[nodiscard]] std::uint16_t port() const noexcept;
+  /// http://ADDRESS:PORT/
+  [[nodiscard]] std::string url() const;
+  [[nodiscard]] ServerStats stats() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// The view of one robot's session (rtc::SimulatedRobot::session, a Manipulator's session).
+std::unique_ptr<Server> serve(rtc::Session& session, std::uint16_t port = 8080,
+                              ServeOptions options = {});
+/// The view of every robot of a cell, with its objects, frames and collision capsules.
+std::unique_ptr<Server> serve(cell::Cell& cell, std::uint16_t port = 8080,
+                              ServeOptions options = {});
+/// A recorded run of `model`, replayed in the page. RunLogError when the log's joints do not
+/// match the robot's.
+std::unique_ptr<Server> serve_replay(const kin::RobotModel& model, RunLog log,
+                                     std::uint16_t port = 8080, ServeOptions options = {});
+
+}  // namespace rccx::view

@@ -1,0 +1,192 @@
+// End-to-end test of `rccx view` in Debian's Chromium, headless, through playwright-core:
+//   1. live: the page loads with no console error; the joint values it draws are the session's
+//      (the server's sample at the page's time, exactly) and no older than one decimated sample
+//      behind the newest; the three plots fill; a second page is open meanwhile; a page for an
+//      unknown robot is a 404 and the server goes on serving;
+//   2. replay: a run recorded with RCCX_LOG, replayed with `rccx view --log`: moving the slider
+//      puts the robot in the logged pose.
+// Screenshots go to ARTIFACT_DIR (view-live.png, view-replay.png).
+//
+//   node view_e2e.mjs RCCX ARTIFACT_DIR NODE_MODULES
+// Exit 0 pass, 1 fail, 77 skipped (no chromium or no node_modules: said why).
+import { spawn } from 'node:child_process';
+import { existsSync, mkdirSync, readFileSync } from 'node:fs';
+import { createRequire } from 'node:module';
+import { join, resolve } from 'node:path';
+
+const [rccx, artifacts, nodeModules] = process.argv.slice(2);
+const chromium = process.env.RCCX_CHROMIUM || '/usr/bin/chromium';
+if (!existsSync(chromium)) {
+  console.log(`SKIP: no ${chromium} (apt-get install chromium; scripts/install-deps does)`);
+  process.exit(77);
+}
+if (!existsSync(join(nodeModules, 'playwright-core'))) {
+  console.log(`SKIP: no ${nodeModules}/playwright-core (npm ci in web/; the build runs it)`);
+  process.exit(77);
+}
+const require = createRequire(join(resolve(nodeModules), 'x.js'));
+const { chromium: pw } = require('playwright-core');
+mkdirSync(artifacts, { recursive: true });
+
+let failures = 0;
+const check = (ok, what) => {
+  console.log(`${ok ? 'ok  ' : 'FAIL'} ${what}`);
+  if (!ok) failures++;
+};
+
+/// Starts rccx with args; resolves with the process and the base URL it prints.
+function start(args, env = {}) {
+  return new Promise((resolve, reject) => {
+    const p = spawn(rccx, args, { env: { ...process.env, ...env }, stdio: ['ignore', 'pipe', 'pipe'] });
+    let err = '';
+    const timer = setTimeout(() => reject(new Error(`rccx ${args.join(' ')}: no address in 20 s: ${err}`)), 20000);
+    p.stderr.on('data', (d) => {
+      err += d;
+      const m = err.match(/open (http:\/\/127\.0\.0\.1:\d+\/)/);
+      if (m) { clearTimeout(timer); resolve({ proc: p, url: m[1] }); }
+    });
+    p.on('exit', (code, signal) => {
+      console.log(`rccx ${args.join(' ')} exited (${code ?? signal}): ${err}`);
+      reject(new Error(`rccx ${args.join(' ')} exited ${code ?? signal}`));
+    });
+  });
+}
+const stop = (p) => new Promise((resolve) => {
+  if (p.exitCode !== null) return resolve(p.exitCode);
+  p.removeAllListeners('exit');
+  p.on('exit', (code) => resolve(code));
+  p.kill('SIGINT');
+});
+const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
+
+async function openPage(browser, url, errors) {
+  const page = await browser.newPage({ viewport: { width: 1280, height: 760 } });
+  page.on('console', (m) => { if (m.type() === 'error') errors.push(`console: ${m.text()}`); });
+  page.on('pageerror', (e) => errors.push(`page: ${e.message}`));
+  await page.goto(url);
+  try {
+    await page.waitForFunction(() => window.rccxView && window.rccxView.ready, null, { timeout: 45000 });
+  } catch (e) {
+    const state = await page.evaluate(() => JSON.stringify(window.rccxView)).catch(() => '?');
+    throw new Error(`${url} not ready in 45 s: ${state}; ${errors.join('; ')}`);
+  }
+  return page;
+}
+
+const browser = await pw.launch({
+  executablePath: chromium,
+  headless: true,
+  args: ['--no-sandbox', '--use-angle=swiftshader', '--enable-unsafe-swiftshader'],
+});
+const procs = [];
+try {
+  // --- 1. Live ------------------------------------------------------------------------------
+  const live = await start(['view', '--robot', 'microbo', '--port', '0', '--seconds', '120']);
+  procs.push(live.proc);
+  const errors = [];
+  const page = await openPage(browser, live.url, errors);
+  const second = await openPage(browser, `${live.url}robot/microbo`, errors);
+  await page.waitForFunction(() => window.rccxView.frames > 40, null, { timeout: 30000 });
+  const rate = (await (await fetch(`${live.url}api/scene`)).json()).rate_hz;
+
+  // The pose drawn, and the server's state, read together in the page.
+  const lags = [];
+  let exact = 0;
+  for (let i = 0; i < 15; ++i) {
+    const { drawn, latest } = await page.evaluate(async () => {
+      const r = window.rccxView.robots[0];
+      const drawn = { t: r.t, q: r.q.slice() };
+      const latest = (await (await fetch('/api/state')).json()).robots[0];
+      return { drawn, latest };
+    });
+    const at = await (await fetch(`${live.url}api/state?robot=microbo&t=${drawn.t}`)).json();
+    const diff = Math.max(...drawn.q.map((q, k) => Math.abs(q - at.q[k])));
+    if (diff < 1e-9) exact++;
+    lags.push(latest.t - drawn.t);
+    await sleep(120);
+  }
+  check(exact === 15, `the drawn joints are the session's decimated sample at the page's time (${exact}/15 exact)`);
+  // How far the pose drawn is behind the newest sample the server has: one decimated sample in
+  // flight, plus whatever the page's main thread was busy with (software WebGL on a loaded
+  // machine); the median must be within one decimated sample and 100 ms of network and page.
+  lags.sort((a, b) => a - b);
+  const median = lags[Math.floor(lags.length / 2)];
+  const period = 1 / rate;
+  const samplePeriod = 0.028;  // the Microbo's: the tap sends one sample of every
+  const decimated = Math.max(period, samplePeriod);
+  check(median <= decimated + 0.1 + 1e-9,
+    `the pose drawn follows the session: median ${(median * 1000).toFixed(0)} ms behind the newest sample ` +
+    `(one decimated sample is ${(decimated * 1000).toFixed(0)} ms), worst ${(lags[lags.length - 1] * 1000).toFixed(0)} ms`);
+  const points = await page.evaluate(() => window.rccxView.plotPoints);
+  check(points.joints > 40 && points.cart > 40 && points.vel > 40,
+    `the plots fill (${points.joints} / ${points.cart} / ${points.vel} points)`);
+  const moved = await page.evaluate(() => window.rccxView.robots[0].q);
+  check(moved.some((q) => Number.isFinite(q)), 'the robot is drawn');
+
+  // Bad input: an unknown robot is a 404 that says which robots there are; the server goes on.
+  const bad = await browser.newPage();
+  const res = await bad.goto(`${live.url}robot/nope`);
+  const badText = await bad.textContent('body');
+  check(res.status() === 404 && /no robot "nope" here; the robots are: microbo/.test(badText),
+    `an unknown robot's page is a 404 naming the robots (${res.status()})`);
+  await bad.close();
+  const framesBefore = await page.evaluate(() => window.rccxView.frames);
+  await sleep(600);
+  const framesAfter = await page.evaluate(() => window.rccxView.frames);
+  check(framesAfter > framesBefore, `the server goes on serving after it (${framesAfter - framesBefore} samples more)`);
+  const api = await fetch(`${live.url}api/scene?robot=nope`);
+  check(api.status === 404 && /no robot "nope"/.test((await api.json()).error), '/api/scene?robot=nope is a 404 with a message');
+
+  await page.screenshot({ path: join(artifacts, 'view-live.png') });
+  check(errors.length === 0, `no console error (${errors.join('; ') || 'none'})`);
+  await second.close();
+  await page.close();
+  check((await stop(live.proc)) === 130, 'rccx view ends on Ctrl-C with 130');
+
+  // --- 2. Replay ----------------------------------------------------------------------------
+  const csv = join(artifacts, 'view-run.csv');
+  const rec = await new Promise((resolve) => {
+    const p = spawn(rccx, ['view', '--robot', 'microbo', '--port', '0', '--fast', '--seconds', '1.5'],
+      { env: { ...process.env, RCCX_LOG: csv }, stdio: 'inherit' });
+    p.on('exit', resolve);
+  });
+  check(rec === 0 && existsSync(csv), `a run recorded with RCCX_LOG (${rec})`);
+  const lines = readFileSync(csv, 'utf8').trim().split('\n');
+  const header = lines[0].split(',');
+  const dof = (header.length - 8) / 2;
+  const rows = lines.slice(1).map((l) => l.split(',').map(Number));
+  const replay = await start(['view', '--log', csv, '--robot', 'microbo', '--port', '0', '--seconds', '120']);
+  procs.push(replay.proc);
+  const rerrors = [];
+  const rpage = await openPage(browser, replay.url, rerrors);
+  check(await rpage.isVisible('#slider'), 'the replay shows its slider');
+  const k = Math.floor(rows.length * 0.6);
+  await rpage.evaluate((k) => {
+    const s = document.getElementById('slider');
+    s.value = String(k);
+    s.dispatchEvent(new Event('input'));
+  }, k);
+  await rpage.waitForTimeout(300);
+  const shown = await rpage.evaluate(() => window.rccxView.robots[0]);
+  const logged = rows[k].slice(2, 2 + dof);
+  const rdiff = Math.max(...logged.map((q, i) => Math.abs(q - shown.q[i])));
+  check(Math.abs(shown.t - rows[k][0]) < 1e-6 && rdiff < 1e-6,
+    `the slider at sample ${k} puts the robot in the logged pose (t ${shown.t}, joints within ${rdiff.toExponential(1)})`);
+  await rpage.click('#play');
+  await rpage.waitForTimeout(500);
+  const played = await rpage.evaluate(() => window.rccxView.robots[0].t);
+  check(played > shown.t, `play moves on (${shown.t.toFixed(3)} -> ${played.toFixed(3)} s)`);
+  const rpoints = await rpage.evaluate(() => window.rccxView.plotPoints);
+  check(rpoints.joints === rows.length, `the replay's plots hold the run (${rpoints.joints} of ${rows.length})`);
+  await rpage.screenshot({ path: join(artifacts, 'view-replay.png') });
+  check(rerrors.length === 0, `no console error in the replay (${rerrors.join('; ') || 'none'})`);
+  await stop(replay.proc);
+} catch (e) {
+  console.log(`FAIL ${e.stack || e}`);
+  failures++;
+} finally {
+  for (const p of procs) await stop(p);
+  await browser.close();
+}
+console.log(failures === 0 ? 'PASS' : `${failures} check(s) failed`);
+process.exit(failures === 0 ? 0 : 1);

@@ -1,0 +1,336 @@
+// rccx::view: the server's HTTP and WebSocket answers, bad input (logs that are not rccx's CSV,
+// a port in use, an unknown robot's page while the server goes on), the tap's decimation, the
+// SVG plots, and `rccx view` / `rccx plot` on the command line.
+#include <gtest/gtest.h>
+
+#include <utility>  // before Boost.Asio 1.74 (std::exchange)
+
+#include <fmt/format.h>
+
+#include <boost/asio.hpp>
+#include <boost/beast/core.hpp>
+#include <boost/beast/http.hpp>
+#include <boost/beast/websocket.hpp>
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <thread>
+
+#include "rccx/rccl/manipulator.hpp"
+#include "rccx/rtc/simulated_robot.hpp"
+#include "rccx/view/plot.hpp"
+#include "rccx/view/run_log.hpp"
+#include "rccx/view/server.hpp"
+#include "shell_run.hpp"
+
+namespace {
+
+using namespace rccx;
+namespace asio = boost::asio;
+namespace beast = boost::beast;
+namespace http = beast::http;
+namespace websocket = beast::websocket;
+using tcp = asio::ip::tcp;
+using json = nlohmann::json;
+using namespace std::chrono_literals;
+
+struct Reply {
+  int status = 0;
+  std::string body;
+  std::string type;
+};
+
+Reply request(std::uint16_t port, const std::string& target, http::verb verb = http::verb::get) {
+  asio::io_context io;
+  beast::tcp_stream stream(io);
+  stream.expires_after(5s);
+  stream.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), port));
+  http::request<http::string_body> req(verb, target, 11);
+  req.set(http::field::host, "127.0.0.1");
+  http::write(stream, req);
+  beast::flat_buffer buffer;
+  http::response<http::string_body> res;
+  http::read(stream, buffer, res);
+  beast::error_code ec;
+  stream.socket().shutdown(tcp::socket::shutdown_both, ec);
+  return {static_cast<int>(res.result_int()), res.body(),
+          std::string(res[http::field::content_type])};
+}
+
+/// The page's folder: a stand-in index.html (the real bundle is the end-to-end test's).
+std::filesystem::path assets_dir() {
+  const auto dir = std::filesystem::temp_directory_path() / "rccx_view_test_assets";
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "index.html") << "<!doctype html><title>rccx view</title>";
+  std::ofstream(dir / "app.js") << "console.log('rccx');";
+  return dir;
+}
+
+view::ServeOptions quiet() {
+  view::ServeOptions o;
+  o.announce = false;
+  o.assets = assets_dir();
+  return o;
+}
+
+/// A simulated PUMA in simulated time moving its first joint, with the view on any free port.
+struct Live {
+  rtc::SimulatedRobot robot{kin::builtin_robot("puma560")};
+  rccl::Manipulator arm{*robot.session};
+  std::unique_ptr<view::Server> server;
+
+  Live() {
+    server = view::serve(*robot.session, 0, quiet());
+    arm.start();
+    kin::JointVector q = robot.model.ready();
+    q[0] += 0.3;
+    arm.move(rccl::Position::joints("A", q));
+    robot.session->wait_for(1s);  // 100 samples at 10 ms; the tap keeps every other one (50 Hz)
+    std::this_thread::sleep_for(150ms);  // the server thread drains every 20 ms
+  }
+};
+
+TEST(ViewServer, ServesThePageTheSceneAndTheSession) {
+  Live live;
+  const std::uint16_t port = live.server->port();
+  ASSERT_NE(port, 0);
+  EXPECT_EQ(live.server->url(), fmt::format("http://127.0.0.1:{}/", port));
+
+  const Reply page = request(port, "/");
+  EXPECT_EQ(page.status, 200);
+  EXPECT_NE(page.body.find("rccx view"), std::string::npos);
+  EXPECT_EQ(page.type, "text/html; charset=utf-8");
+  EXPECT_EQ(request(port, "/robot/puma560").status, 200);
+  EXPECT_EQ(request(port, "/assets/app.js").type, "text/javascript; charset=utf-8");
+  EXPECT_EQ(request(port, "/assets/..%2Fsecret").status, 404);
+
+  const json scene = json::parse(request(port, "/api/scene").body);
+  ASSERT_EQ(scene["robots"].size(), 1U);
+  EXPECT_EQ(scene["robots"][0]["name"], "puma560");
+  EXPECT_EQ(scene["robots"][0]["joints"].size(), 6U);
+  EXPECT_DOUBLE_EQ(scene["robots"][0]["joints"][1]["a"].get<double>(),
+                   live.robot.model.joints[1].dh.a_m);
+  EXPECT_EQ(scene["mode"], "live");
+
+  // The last sample the server has is the session's, decimated to 50 Hz of sample time.
+  const json state = json::parse(request(port, "/api/state").body);
+  ASSERT_EQ(state["robots"].size(), 1U);
+  const json& latest = state["robots"][0];
+  const rtc::How how = live.robot.session->how();
+  EXPECT_NEAR(latest["t"].get<double>(), how.time_s, 0.02 + 1e-9);
+  EXPECT_NEAR(latest["qm"][0].get<double>(), how.joint[0].q, 0.02);
+  const view::ServerStats st = live.server->stats();
+  EXPECT_GE(st.samples_sent, 45U);
+  EXPECT_LE(st.samples_sent, 55U);
+  EXPECT_EQ(st.samples_dropped, 0U);
+  // A sample by its time.
+  const Reply at =
+      request(port, fmt::format("/api/state?robot=puma560&t={}", latest["t"].get<double>()));
+  EXPECT_EQ(at.status, 200);
+  EXPECT_EQ(json::parse(at.body)["q"], latest["q"]);
+}
+
+TEST(ViewServer, WebSocketSendsHistoryThenLiveSamples) {
+  Live live;
+  asio::io_context io;
+  websocket::stream<beast::tcp_stream> ws(io);
+  beast::get_lowest_layer(ws).expires_after(10s);
+  beast::get_lowest_layer(ws).connect(
+      tcp::endpoint(asio::ip::make_address("127.0.0.1"), live.server->port()));
+  ws.handshake("127.0.0.1", "/ws?robot=puma560");
+  beast::flat_buffer buffer;
+  ws.read(buffer);
+  EXPECT_EQ(json::parse(beast::buffers_to_string(buffer.data()))["type"], "hello");
+  buffer.clear();
+  ws.read(buffer);
+  const json history = json::parse(beast::buffers_to_string(buffer.data()));
+  EXPECT_EQ(history["type"], "frames");
+  EXPECT_TRUE(history["history"].get<bool>());
+  EXPECT_GE(history["frames"].size(), 3U);  // simulated time: a few a server tick
+  EXPECT_EQ(history["frames"][0]["q"].size(), 6U);
+  EXPECT_EQ(history["frames"][0]["p"].size(), 3U);
+
+  // New samples arrive as the robot moves on.
+  live.robot.session->wait_for(200ms);
+  buffer.clear();
+  ws.read(buffer);
+  const json more = json::parse(beast::buffers_to_string(buffer.data()));
+  ASSERT_FALSE(more["frames"].empty());
+  EXPECT_GT(more["frames"][0]["t"].get<double>(), history["frames"].back()["t"].get<double>());
+  EXPECT_EQ(live.server->stats().pages, 1U);
+  ws.close(websocket::close_code::normal);
+}
+
+TEST(ViewServer, UnknownRobotIsA404AndTheServerGoesOn) {
+  Live live;
+  const std::uint16_t port = live.server->port();
+  const Reply page = request(port, "/robot/nope");
+  EXPECT_EQ(page.status, 404);
+  EXPECT_NE(page.body.find("no robot &quot;nope&quot; here; the robots are: puma560"),
+            std::string::npos)
+      << page.body;
+  const Reply api = request(port, "/api/scene?robot=nope");
+  EXPECT_EQ(api.status, 404);
+  EXPECT_EQ(json::parse(api.body)["error"], "no robot \"nope\" here; the robots are: puma560");
+  EXPECT_EQ(request(port, "/ws?robot=nope").status, 404);
+  EXPECT_EQ(request(port, "/nothing").status, 404);
+  EXPECT_EQ(request(port, "/api/log").status, 404);  // live, not a replay
+  // Still serving.
+  EXPECT_EQ(request(port, "/api/scene").status, 200);
+  EXPECT_EQ(request(port, "/").status, 200);
+}
+
+TEST(ViewServer, IsReadOnly) {
+  Live live;
+  for (http::verb v : {http::verb::post, http::verb::put, http::verb::delete_}) {
+    const Reply r = request(live.server->port(), "/api/state", v);
+    EXPECT_EQ(r.status, 405);
+    EXPECT_NE(r.body.find("read-only"), std::string::npos);
+  }
+}
+
+TEST(ViewServer, PortInUseSaysWhatToDo) {
+  view::Server first(view::Scene::of_robot(kin::builtin_robot("microbo")), 0, quiet());
+  try {
+    view::Server second(view::Scene::of_robot(kin::builtin_robot("microbo")), first.port(),
+                        quiet());
+    FAIL() << "a second server on the same port";
+  } catch (const view::ViewError& e) {
+    EXPECT_NE(
+        std::string(e.what()).find(fmt::format("port {} on 127.0.0.1 is in use", first.port())),
+        std::string::npos)
+        << e.what();
+    EXPECT_NE(std::string(e.what()).find("--port 0"), std::string::npos);
+  }
+  EXPECT_EQ(request(first.port(), "/").status, 200);  // the first goes on
+  view::ServeOptions bad = quiet();
+  bad.address = "localhost:80";
+  EXPECT_THROW(view::Server(view::Scene::of_robot(kin::builtin_robot("microbo")), 0, bad),
+               view::ViewError);
+}
+
+TEST(ViewServer, DetachesFromTheSessionWhileItRuns) {
+  rtc::SimulatedRobotOptions options;
+  options.clock = rtc::ClockKind::real_time;
+  rtc::SimulatedRobot robot(kin::builtin_robot("puma560"), options);
+  rccl::Manipulator arm(*robot.session);
+  arm.start();
+  for (int i = 0; i < 5; ++i) {
+    auto server = view::serve(*robot.session, 0, quiet());
+    std::this_thread::sleep_for(60ms);
+  }  // each destroyed while the loop calls its tap
+  EXPECT_TRUE(robot.session->controlling());
+}
+
+constexpr const char* kGoodLog =
+    "t,seg,q1,q2,qm1,qm2,x,y,z,ax,ay,az\n"
+    "0.01,0,0.1,0.2,0.1,0.2,0.5,0,0.3,0,0,-1\n"
+    "0.02,1,0.11,0.2,0.1,0.2,0.51,0,0.3,0,0,-1\n";
+
+TEST(RunLog, ReadsWhatSampleLogWrites) {
+  const view::RunLog log = view::parse_run_log(kGoodLog, "run.csv");
+  EXPECT_EQ(log.dof, 2U);
+  ASSERT_EQ(log.rows.size(), 2U);
+  EXPECT_DOUBLE_EQ(log.rows[1].commanded[0], 0.11);
+  EXPECT_EQ(log.rows[1].segment, 1);
+  EXPECT_DOUBLE_EQ(log.rows[1].p[0], 0.51);
+}
+
+TEST(RunLog, RefusesOtherFilesNamingLineAndColumn) {
+  const auto message = [](std::string_view text) {
+    try {
+      (void)view::parse_run_log(text, "run.csv");
+    } catch (const view::RunLogError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_NE(message("").find("run.csv: empty"), std::string::npos);
+  EXPECT_NE(message("time,x,y\n1,2,3\n")
+                .find("run.csv:1: the header \"time,x,y\" is not a log "
+                      "rccx writes"),
+            std::string::npos);
+  EXPECT_NE(message("t,seg,q1,q2,qm1,qm2,x,y,z,ax,ay,bz\n")
+                .find("run.csv:1: column 12 is \"bz\", "
+                      "expected az"),
+            std::string::npos);
+  EXPECT_NE(message("t,seg,q1,q2,qm1,qm2,x,y,z,ax,ay,az\n").find("a header and no samples"),
+            std::string::npos);
+  std::string bad_number = kGoodLog;
+  bad_number += "0.03,1,0.11,abc,0.1,0.2,0.51,0,0.3,0,0,-1\n";
+  EXPECT_NE(message(bad_number).find("run.csv:4: column 4 (q2)"), std::string::npos)
+      << message(bad_number);
+  std::string short_row = kGoodLog;
+  short_row += "0.03,1,0.11\n";
+  EXPECT_NE(message(short_row).find("run.csv:4: 3 columns, the header has 12"), std::string::npos);
+  std::string backwards = kGoodLog;
+  backwards += "0.015,1,0.11,0.2,0.1,0.2,0.51,0,0.3,0,0,-1\n";
+  EXPECT_NE(message(backwards).find("run.csv:4: column 1 (t): time 0.015 does not follow 0.02"),
+            std::string::npos);
+  std::string nan = kGoodLog;
+  nan += "0.03,1,nan,0.2,0.1,0.2,0.51,0,0.3,0,0,-1\n";
+  EXPECT_NE(message(nan).find("run.csv:4: column 3 (q1)"), std::string::npos);
+}
+
+TEST(RunLog, ReplayRefusesALogOfAnotherRobot) {
+  const view::RunLog log = view::parse_run_log(kGoodLog, "run.csv");
+  EXPECT_THROW(view::serve_replay(kin::builtin_robot("puma560"), log, 0, quiet()),
+               view::RunLogError);
+}
+
+TEST(Plot, DrawsTheFourPanels) {
+  // A recorded run of the PUMA (RCCX_LOG's format, through SampleLog itself).
+  const auto file = std::filesystem::temp_directory_path() / "rccx_view_test_run.csv";
+  {
+    rtc::SimulatedRobotOptions options;
+    options.log = file;
+    rtc::SimulatedRobot robot(kin::builtin_robot("puma560"), options);
+    rccl::Manipulator arm(*robot.session);
+    arm.start();
+    kin::JointVector q = robot.model.ready();
+    q[0] += 0.3;
+    arm.waitfor(arm.move(rccl::Position::joints("A", q)).end());
+    arm.stop_control();
+    EXPECT_EQ(robot.finish(), "");
+  }
+  const view::RunLog log = view::load_run_log(file);
+  const std::string svg = view::plot_svg(log, kin::builtin_robot("puma560"), "a <test> run");
+  EXPECT_EQ(svg.rfind("<svg", 0), 0U);
+  for (const char* part : {"Joints", "Tool path in the", "Speed along the path", "Path error",
+                           "a &lt;test&gt; run", "</svg>"}) {
+    EXPECT_NE(svg.find(part), std::string::npos) << part;
+  }
+  EXPECT_GE(std::count(svg.begin(), svg.end(), '\n'), 20);
+  EXPECT_THROW((void)view::plot_svg(view::parse_run_log(kGoodLog, "two.csv"),
+                                    kin::builtin_robot("puma560"), "x"),
+               view::RunLogError);
+  std::filesystem::remove(file);
+}
+
+TEST(ViewCli, BadInputExitsTwoWithWhatToDo) {
+  const auto dir = std::filesystem::temp_directory_path() / "rccx_view_cli_test";
+  std::filesystem::create_directories(dir);
+  const auto bad = dir / "bad.csv";
+  std::ofstream(bad) << "time,x\n1,2\n";
+  auto r = test::rccx_run(fmt::format("plot {} -o {}/out.svg", bad.string(), dir.string()));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.out.find(":1: the header"), std::string::npos) << r.out;
+  EXPECT_FALSE(std::filesystem::exists(dir / "out.svg"));
+  r = test::rccx_run(fmt::format("view --log {} --port 0 --seconds 1", bad.string()));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.out.find("--log: "), std::string::npos) << r.out;
+
+  std::ofstream(dir / "good.csv") << kGoodLog;
+  r = test::rccx_run(fmt::format("plot {}/good.csv -o {}/out.png", dir.string(), dir.string()));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.out.find("name the file *.svg"), std::string::npos) << r.out;
+
+  view::Server taken(view::Scene::of_robot(kin::builtin_robot("microbo")), 0, quiet());
+  r = test::rccx_run(fmt::format("view --robot microbo --port {} --seconds 1", taken.port()));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.out.find("is in use"), std::string::npos) << r.out;
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace

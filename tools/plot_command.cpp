@@ -1,0 +1,68 @@
+#include "plot_command.hpp"
+
+#include <fmt/format.h>
+
+#include <filesystem>
+#include <memory>
+#include <string>
+
+#include "rccx/io/file.hpp"
+#include "rccx/view/plot.hpp"
+#include "rccx/view/run_log.hpp"
+
+namespace rccx::tools {
+
+namespace {
+
+struct PlotArgs {
+  RobotChoice robot{"microbo"};
+  std::string log;
+  std::string out;
+  std::string title;
+};
+
+int run_plot(const PlotArgs& a) {
+  const kin::RobotModel model = a.robot.model();
+  const std::filesystem::path out(a.out);
+  const std::string ext = out.extension().string();
+  if (ext != ".svg") {
+    throw BadArgument{fmt::format("-o {}: rccx plot writes SVG; name the file *.svg", a.out)};
+  }
+  view::RunLog log;
+  std::string svg;
+  try {
+    log = view::load_run_log(a.log);
+    svg = view::plot_svg(
+        log, model, a.title.empty() ? std::filesystem::path(a.log).filename().string() : a.title);
+  } catch (const view::RunLogError& e) {
+    throw BadArgument{e.what()};
+  }
+  io::AtomicFile file(out);
+  file.write(svg);
+  file.commit();
+  fmt::print("{}: {} samples, {:.2f} s -> {}\n", a.log, log.rows.size(),
+             log.rows.back().t_s - log.rows.front().t_s, a.out);
+  return kOk;
+}
+
+}  // namespace
+
+void add_plot_command(CLI::App& app, int& exit_code) {
+  auto args = std::make_shared<PlotArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "plot",
+      "Plot a recorded run (a CSV written by --log or RCCX_LOG) as an SVG, without a browser: "
+      "the joints, the tool path in the plane it moves in most, the speed along the path and "
+      "the path error (the measured tool from the commanded path).");
+  cmd->add_option("log", args->log, "The run: a CSV rccx wrote (--log FILE, RCCX_LOG=FILE)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("-o,--output", args->out, "The SVG to write (replaced whole)")
+      ->required()
+      ->check(not_empty());
+  add_robot_options(*cmd, args->robot);
+  cmd->add_option("--title", args->title, "The heading (default: the log's file name)");
+  cmd->callback([args, &exit_code] { guarded(exit_code, [&] { return run_plot(*args); }); });
+}
+
+}  // namespace rccx::tools

@@ -1,0 +1,498 @@
+// The page `rccx view` serves: the robots in 3D (three.js), drawn from their DH chains, with the
+// tool path traced, named frames, the cell's objects and capsules; live joint, Cartesian and
+// velocity plots (uPlot); and, for a recorded run, a replay with a time slider.
+//
+// What the page draws is also in window.rccxView (for the end-to-end test): the joint values
+// and time of the pose drawn, per robot, and how many points each plot holds.
+import * as THREE from 'three';
+import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
+import { CSS2DRenderer, CSS2DObject } from 'three/examples/jsm/renderers/CSS2DRenderer.js';
+import uPlot from 'uplot';
+import 'uplot/dist/uPlot.min.css';
+import './style.css';
+
+const view = {
+  ready: false,
+  mode: 'live',
+  errors: [],
+  frames: 0,
+  robots: [],
+  plotPoints: { joints: 0, cart: 0, vel: 0 },
+};
+window.rccxView = view;
+
+const $ = (id) => document.getElementById(id);
+const status = (text, bad = false) => {
+  $('status').textContent = text;
+  $('status').className = bad ? 'bad' : '';
+};
+
+// --- Kinematics: standard DH, as rccx::kin::link_frames ---------------------------------------
+function dhMatrix(j, q) {
+  const theta = j.theta + (j.prismatic ? 0 : q);
+  const d = j.d + (j.prismatic ? q : 0);
+  const ct = Math.cos(theta), st = Math.sin(theta);
+  const ca = Math.cos(j.alpha), sa = Math.sin(j.alpha);
+  return new THREE.Matrix4().set(
+    ct, -st * ca, st * sa, j.a * ct,
+    st, ct * ca, -ct * sa, j.a * st,
+    0, sa, ca, d,
+    0, 0, 0, 1);
+}
+
+/// base, base A1, base A1 A2, ... (dof + 1 frames).
+function linkFrames(robot, q) {
+  const frames = [robot.baseMatrix.clone()];
+  for (let i = 0; i < robot.joints.length; ++i) {
+    frames.push(frames[i].clone().multiply(dhMatrix(robot.joints[i], q[i])));
+  }
+  return frames;
+}
+
+// --- Scene ----------------------------------------------------------------------------------
+const container = $('scene');
+const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
+renderer.setPixelRatio(window.devicePixelRatio);
+container.appendChild(renderer.domElement);
+const labels = new CSS2DRenderer();
+labels.domElement.style.position = 'absolute';
+labels.domElement.style.top = '0';
+labels.domElement.style.pointerEvents = 'none';
+container.appendChild(labels.domElement);
+
+const scene = new THREE.Scene();
+scene.background = new THREE.Color(0x15171c);
+const camera = new THREE.PerspectiveCamera(45, 1, 0.01, 100);
+camera.up.set(0, 0, 1);
+camera.position.set(1.2, -1.4, 1.0);
+const controls = new OrbitControls(camera, renderer.domElement);
+controls.target.set(0, 0, 0.25);
+controls.update();
+scene.add(new THREE.HemisphereLight(0xffffff, 0x334455, 2.0));
+const sun = new THREE.DirectionalLight(0xffffff, 1.5);
+sun.position.set(2, -1, 3);
+scene.add(sun);
+const grid = new THREE.GridHelper(2, 20, 0x555a66, 0x30343c);
+grid.rotation.x = Math.PI / 2;
+scene.add(grid);
+scene.add(new THREE.AxesHelper(0.15));
+
+function resize() {
+  const w = container.clientWidth, h = container.clientHeight;
+  renderer.setSize(w, h);
+  labels.setSize(w, h);
+  camera.aspect = w / Math.max(h, 1);
+  camera.updateProjectionMatrix();
+}
+window.addEventListener('resize', resize);
+
+function label(text) {
+  const div = document.createElement('div');
+  div.className = 'label';
+  div.textContent = text;
+  return new CSS2DObject(div);
+}
+
+const Y = new THREE.Vector3(0, 1, 0);
+/// A unit cylinder (height 1 along y) put between p0 and p1.
+function placeBetween(mesh, p0, p1) {
+  const dir = new THREE.Vector3().subVectors(p1, p0);
+  const len = dir.length();
+  mesh.visible = len > 1e-6;
+  if (!mesh.visible) return;
+  mesh.position.copy(p0).addScaledVector(dir, 0.5);
+  mesh.quaternion.setFromUnitVectors(Y, dir.divideScalar(len));
+  mesh.scale.y = len;
+}
+
+const colours = [0xe0a040, 0x50a0e0, 0x80d080, 0xd070d0];
+
+class RobotView {
+  constructor(desc, index) {
+    this.name = desc.name;
+    this.joints = desc.joints;
+    this.baseMatrix = new THREE.Matrix4().fromArray(desc.base);
+    this.toolMatrix = desc.tool ? new THREE.Matrix4().fromArray(desc.tool) : new THREE.Matrix4();
+    this.radii = desc.radii || [];
+    // The links' size sets the drawing's scale.
+    const reach = desc.joints.reduce((s, j) => s + Math.abs(j.a) + Math.abs(j.d), 0) || 0.5;
+    this.thick = Math.max(0.008, reach * 0.02);
+    const colour = colours[index % colours.length];
+    const linkMat = new THREE.MeshStandardMaterial({ color: colour, metalness: 0.2, roughness: 0.6 });
+    const jointMat = new THREE.MeshStandardMaterial({ color: 0x30343c, metalness: 0.4, roughness: 0.5 });
+    const capsuleMat = new THREE.MeshStandardMaterial({ color: 0xff5050, transparent: true,
+      opacity: 0.18, depthWrite: false });
+    this.group = new THREE.Group();
+    scene.add(this.group);
+    const cyl = new THREE.CylinderGeometry(1, 1, 1, 16);
+    this.links = [];   // per joint: the d part and the a part
+    this.capsules = [];
+    this.jointMeshes = [];
+    for (let i = 0; i < desc.joints.length; ++i) {
+      const parts = [];
+      for (let k = 0; k < 2; ++k) {
+        const m = new THREE.Mesh(cyl, linkMat);
+        m.scale.set(this.thick, 1, this.thick);
+        this.group.add(m);
+        parts.push(m);
+      }
+      this.links.push(parts);
+      const jm = new THREE.Mesh(cyl, jointMat);
+      jm.scale.set(this.thick * 1.6, this.thick * 3, this.thick * 1.6);
+      this.group.add(jm);
+      this.jointMeshes.push(jm);
+      if (this.radii.length) {
+        const r = this.radii[Math.min(i, this.radii.length - 1)];
+        const caps = [];
+        for (let k = 0; k < 2; ++k) {
+          const c = new THREE.Mesh(cyl, capsuleMat);
+          c.scale.set(r, 1, r);
+          this.group.add(c);
+          caps.push(c);
+        }
+        const sphere = new THREE.Mesh(new THREE.SphereGeometry(r, 16, 12), capsuleMat);
+        this.group.add(sphere);
+        caps.push(sphere);
+        this.capsules.push(caps);
+      }
+    }
+    const baseMesh = new THREE.Mesh(cyl, jointMat);
+    baseMesh.scale.set(this.thick * 3, this.thick * 1.5, this.thick * 3);
+    baseMesh.quaternion.setFromUnitVectors(Y, new THREE.Vector3(0, 0, 1));
+    baseMesh.position.setFromMatrixPosition(this.baseMatrix);
+    baseMesh.applyMatrix4(new THREE.Matrix4().extractRotation(this.baseMatrix));
+    baseMesh.position.setFromMatrixPosition(this.baseMatrix);
+    this.group.add(baseMesh);
+    this.tool = new THREE.AxesHelper(Math.max(0.05, reach * 0.12));
+    this.tool.matrixAutoUpdate = false;
+    this.group.add(this.tool);
+    const nameLabel = label(desc.name);
+    nameLabel.position.setFromMatrixPosition(this.baseMatrix);
+    this.group.add(nameLabel);
+    // The tool path: a line through the last points the tool passed.
+    this.pathCapacity = 20000;
+    this.pathPositions = new Float32Array(this.pathCapacity * 3);
+    this.pathCount = 0;
+    const pg = new THREE.BufferGeometry();
+    pg.setAttribute('position', new THREE.BufferAttribute(this.pathPositions, 3));
+    pg.setDrawRange(0, 0);
+    this.path = new THREE.Line(pg, new THREE.LineBasicMaterial({ color: 0xffff66 }));
+    this.path.frustumCulled = false;
+    scene.add(this.path);
+    this.state = { name: desc.name, t: null, q: desc.joints.map((j) => j.ready), seg: 0 };
+    view.robots.push(this.state);
+    this.pose(this.state.q);
+  }
+
+  /// Draws the arm at joint values q.
+  pose(q) {
+    const f = linkFrames(this, q);
+    const o = f.map((m) => new THREE.Vector3().setFromMatrixPosition(m));
+    for (let i = 0; i < this.joints.length; ++i) {
+      // Link i+1: d along z_i, then a along x_(i+1) (as rccx::cell::RobotCapsules).
+      const z = new THREE.Vector3().setFromMatrixColumn(f[i], 2);
+      const d = this.joints[i].d + (this.joints[i].prismatic ? q[i] : 0);
+      const mid = o[i].clone().addScaledVector(z, d);
+      placeBetween(this.links[i][0], o[i], mid);
+      placeBetween(this.links[i][1], mid, o[i + 1]);
+      const jm = this.jointMeshes[i];
+      jm.position.copy(o[i]);
+      jm.quaternion.setFromUnitVectors(Y, z);
+      if (this.capsules.length) {
+        const [c0, c1, s] = this.capsules[i];
+        placeBetween(c0, o[i], mid);
+        placeBetween(c1, mid, o[i + 1]);
+        s.position.copy(o[i + 1]);
+      }
+    }
+    this.tool.matrix.copy(f[f.length - 1]).multiply(this.toolMatrix);
+  }
+
+  addPathPoint(p) {
+    if (this.pathCount === this.pathCapacity) {
+      this.pathPositions.copyWithin(0, 3 * (this.pathCapacity / 2));
+      this.pathCount = this.pathCapacity / 2;
+    }
+    this.pathPositions.set(p, 3 * this.pathCount++);
+    this.path.geometry.setDrawRange(0, this.pathCount);
+    this.path.geometry.attributes.position.needsUpdate = true;
+  }
+
+  clearPath() {
+    this.pathCount = 0;
+    this.path.geometry.setDrawRange(0, 0);
+  }
+}
+
+function addObject(o) {
+  let geometry;
+  if (o.kind === 'box') {
+    geometry = new THREE.BoxGeometry(o.size[0], o.size[1], o.size[2]);
+  } else {
+    geometry = new THREE.CylinderGeometry(o.radius, o.radius, o.height, 32);
+    geometry.rotateX(Math.PI / 2);  // its axis is the pose's z
+  }
+  const mesh = new THREE.Mesh(geometry, new THREE.MeshStandardMaterial({
+    color: 0x6a7080, transparent: true, opacity: 0.55 }));
+  mesh.matrixAutoUpdate = false;
+  mesh.matrix.fromArray(o.pose);
+  scene.add(mesh);
+  const l = label(o.name);
+  l.position.setFromMatrixPosition(mesh.matrix);
+  scene.add(l);
+}
+
+const frameObjects = new Map();
+function addFrame(f) {
+  if (frameObjects.has(f.name)) return;
+  const axes = new THREE.AxesHelper(0.06);
+  axes.matrixAutoUpdate = false;
+  axes.matrix.fromArray(f.pose);
+  scene.add(axes);
+  const l = label(f.name);
+  l.position.setFromMatrixPosition(axes.matrix);
+  l.element.title = f.note || f.name;
+  scene.add(l);
+  frameObjects.set(f.name, axes);
+}
+
+// --- Plots ------------------------------------------------------------------------------------
+const plotWidth = () => Math.max(300, $('plots').clientWidth - 12);
+const axisStyle = { stroke: '#aab', grid: { stroke: '#2c3038' }, ticks: { stroke: '#2c3038' } };
+const seriesColours = ['#e0a040', '#50a0e0', '#80d080', '#d070d0', '#e06060', '#60d0d0', '#c0c060', '#a080ff'];
+
+function makePlot(el, title, names, unit) {
+  const series = [{ label: 't s' }].concat(names.map((n, i) => ({
+    label: n, stroke: seriesColours[i % seriesColours.length], width: 1.5,
+  })));
+  return new uPlot({
+    title, width: plotWidth(), height: 170, series,
+    scales: { x: { time: false } },
+    axes: [{ ...axisStyle, label: 's' }, { ...axisStyle, label: unit, size: 55 }],
+    legend: { live: true },
+  }, [[], ...names.map(() => [])], el);
+}
+
+class Plots {
+  constructor(robot, desc) {
+    this.robot = robot;
+    this.units = desc.joints.map((j) => (j.prismatic ? 1000 : 180 / Math.PI));
+    const names = desc.joints.map((j, i) => `q${i + 1} ${j.prismatic ? 'mm' : 'deg'}`);
+    this.joints = makePlot($('plot-joints'), `${desc.name}: joints (measured)`, names, 'deg / mm');
+    this.cart = makePlot($('plot-cart'), `${desc.name}: tool position (world)`, ['x', 'y', 'z'], 'mm');
+    this.vel = makePlot($('plot-vel'), `${desc.name}: speeds`,
+      desc.joints.map((j, i) => `qd${i + 1} ${j.prismatic ? 'mm/s' : 'deg/s'}`).concat(['tool mm/s']),
+      'deg/s, mm/s');
+    this.limit = 3000;
+    this.data = {
+      joints: [[], ...names.map(() => [])],
+      cart: [[], [], [], []],
+      vel: [[], ...names.map(() => []), []],
+    };
+    this.dirty = false;
+  }
+  push(f) {
+    const n = this.units.length;
+    const d = this.data;
+    d.joints[0].push(f.t);
+    d.cart[0].push(f.t);
+    d.vel[0].push(f.t);
+    for (let i = 0; i < n; ++i) {
+      d.joints[i + 1].push(f.qm[i] * this.units[i]);
+      d.vel[i + 1].push(f.qd[i] * this.units[i]);
+    }
+    d.vel[n + 1].push(f.v * 1000);
+    for (let k = 0; k < 3; ++k) d.cart[k + 1].push(f.p[k] * 1000);
+    for (const key of ['joints', 'cart', 'vel']) {
+      if (d[key][0].length > this.limit) for (const a of d[key]) a.splice(0, a.length - this.limit);
+    }
+    this.dirty = true;
+  }
+  /// A whole recorded run (replay).
+  setRun(log) {
+    const n = this.units.length;
+    const d = this.data;
+    d.joints = [log.t, ...Array.from({ length: n }, (_, i) => log.qm.map((q) => q[i] * this.units[i]))];
+    d.cart = [log.t, ...[0, 1, 2].map((k) => log.p.map((p) => p[k] * 1000))];
+    const speed = log.p.map((p, i) => {
+      if (i === 0) return 0;
+      const a = log.p[i - 1], dt = log.t[i] - log.t[i - 1];
+      return (1000 * Math.hypot(p[0] - a[0], p[1] - a[1], p[2] - a[2])) / dt;
+    });
+    const qd = Array.from({ length: n }, (_, i) => log.qm.map((q, k) => (k === 0 ? 0
+      : ((q[i] - log.qm[k - 1][i]) * this.units[i]) / (log.t[k] - log.t[k - 1]))));
+    d.vel = [log.t, ...qd, speed];
+    this.dirty = true;
+  }
+  flush() {
+    if (!this.dirty) return;
+    this.dirty = false;
+    this.joints.setData(this.data.joints);
+    this.cart.setData(this.data.cart);
+    this.vel.setData(this.data.vel);
+    view.plotPoints = {
+      joints: this.data.joints[0].length, cart: this.data.cart[0].length, vel: this.data.vel[0].length,
+    };
+  }
+  resize() {
+    for (const p of [this.joints, this.cart, this.vel]) p.setSize({ width: plotWidth(), height: 170 });
+  }
+}
+
+// --- Readout ------------------------------------------------------------------------------------
+function readout(robot, desc, t) {
+  const q = robot.state.q;
+  const parts = desc.joints.map((j, i) => (j.prismatic ? `${(q[i] * 1000).toFixed(1)}mm`
+    : `${((q[i] * 180) / Math.PI).toFixed(2)}°`));
+  $('readout').textContent = `${desc.name}  t ${t == null ? '-' : t.toFixed(3)} s  seg ${robot.state.seg}\n${parts.join('  ')}`;
+}
+
+// --- Start ------------------------------------------------------------------------------------
+async function main() {
+  const m = location.pathname.match(/^\/robot\/([^/]+)$/);
+  const only = m ? decodeURIComponent(m[1]) : null;
+  const res = await fetch(only ? `/api/scene?robot=${encodeURIComponent(only)}` : '/api/scene');
+  const desc = await res.json();
+  if (!res.ok) throw new Error(desc.error || `the scene: HTTP ${res.status}`);
+  view.mode = desc.mode;
+  $('title').textContent = `rccx view: ${desc.title}`;
+  document.title = `rccx view: ${desc.title}`;
+  if (desc.robots.length > 1 || only) {
+    $('robots').innerHTML = ['<a href="/">all</a>'].concat(desc.robots.length > 1
+      ? desc.robots.map((r) => `<a href="/robot/${encodeURIComponent(r.name)}">${r.name}</a>`) : []).join('');
+  }
+  const robots = new Map();
+  desc.robots.forEach((r, i) => robots.set(r.index, new RobotView(r, i)));
+  desc.objects.forEach(addObject);
+  desc.frames.forEach(addFrame);
+  // The camera takes in every robot at its ready pose and the objects.
+  const box = new THREE.Box3();
+  for (const r of robots.values()) {
+    for (const m of linkFrames(r, r.state.q)) box.expandByPoint(new THREE.Vector3().setFromMatrixPosition(m));
+  }
+  for (const o of desc.objects) box.expandByPoint(new THREE.Vector3(o.pose[12], o.pose[13], o.pose[14]));
+  if (!box.isEmpty()) {
+    const centre = box.getCenter(new THREE.Vector3());
+    const size = Math.max(0.3, box.getSize(new THREE.Vector3()).length());
+    controls.target.copy(centre);
+    camera.position.copy(centre).add(new THREE.Vector3(0.9, -1.2, 0.7).multiplyScalar(size * 0.95));
+    controls.update();
+  }
+  const first = desc.robots[0];
+  const plots = new Plots(robots.get(first.index), first);
+  resize();
+  window.addEventListener('resize', () => plots.resize());
+
+  // Frames the program adds while it runs (position equations shown later).
+  setInterval(async () => {
+    try {
+      const s = await (await fetch(only ? `/api/scene?robot=${encodeURIComponent(only)}` : '/api/scene')).json();
+      s.frames.forEach(addFrame);
+    } catch { /* the program ended: the status line says so */ }
+  }, 2000);
+
+  let latest = null;
+  if (desc.mode === 'replay') {
+    await replay(robots.get(first.index), first, plots);
+  } else {
+    const ws = new WebSocket(`ws://${location.host}/ws${only ? `?robot=${encodeURIComponent(only)}` : ''}`);
+    ws.onopen = () => status('live');
+    ws.onclose = () => status('the program has ended (no more samples)', true);
+    ws.onmessage = (ev) => {
+      const msg = JSON.parse(ev.data);
+      if (msg.type !== 'frames') return;
+      for (const f of msg.frames) {
+        const r = robots.get(f.r);
+        if (!r) continue;
+        // The scene graph takes the pose at once (a few matrix products); the next animation
+        // frame shows it. rccxView holds what the scene graph holds.
+        r.pose(f.q);
+        r.state.t = f.t;
+        r.state.q = f.q.slice();
+        r.state.seg = f.seg;
+        r.addPathPoint(f.p);
+        if (f.r === first.index) plots.push(f);
+        view.frames++;
+        latest = f;
+      }
+    };
+  }
+
+  function frame() {
+    for (const r of robots.values()) {
+      if (r.pending) {
+        r.pose(r.pending.q);
+        r.state.t = r.pending.t;
+        r.state.q = r.pending.q.slice();
+        r.state.seg = r.pending.seg;
+        r.pending = null;
+      }
+    }
+    if (desc.mode !== 'replay') {
+      plots.flush();
+      readout(robots.get(first.index), first, latest ? robots.get(first.index).state.t : null);
+    }
+    controls.update();
+    renderer.render(scene, camera);
+    labels.render(scene, camera);
+    requestAnimationFrame(frame);
+  }
+  requestAnimationFrame(frame);
+  view.ready = true;
+}
+
+async function replay(robot, desc, plots) {
+  const log = await (await fetch('/api/log')).json();
+  $('replay').hidden = false;
+  status(`replay: ${log.t.length} samples, ${(log.t[log.t.length - 1] - log.t[0]).toFixed(2)} s`);
+  robot.clearPath();
+  for (const p of log.p) robot.addPathPoint(p);
+  plots.setRun(log);
+  plots.flush();
+  resize();
+  plots.resize();
+  const slider = $('slider');
+  slider.max = String(log.t.length - 1);
+  let index = 0;
+  const show = (i) => {
+    index = Math.max(0, Math.min(log.t.length - 1, i));
+    slider.value = String(index);
+    robot.pending = { q: log.q[index], t: log.t[index], seg: log.seg[index] };
+    robot.state.t = log.t[index];
+    robot.state.q = log.q[index].slice();
+    robot.state.seg = log.seg[index];
+    robot.state.index = index;
+    $('replay-time').textContent = `${log.t[index].toFixed(3)} s`;
+    readout(robot, desc, log.t[index]);
+  };
+  slider.addEventListener('input', () => { playing = false; $('play').textContent = 'Play'; show(Number(slider.value)); });
+  let playing = false;
+  let last = 0;
+  $('play').addEventListener('click', () => {
+    playing = !playing;
+    $('play').textContent = playing ? 'Pause' : 'Play';
+    if (playing && index >= log.t.length - 1) show(0);
+    last = performance.now();
+  });
+  const step = (now) => {
+    if (playing) {
+      const speed = Number($('speed').value);
+      const target = log.t[index] + ((now - last) / 1000) * speed;
+      last = now;
+      let i = index;
+      while (i < log.t.length - 1 && log.t[i + 1] <= target) ++i;
+      show(i);
+      if (i >= log.t.length - 1) { playing = false; $('play').textContent = 'Play'; }
+    }
+    requestAnimationFrame(step);
+  };
+  requestAnimationFrame(step);
+  show(0);
+}
+
+window.addEventListener('error', (e) => view.errors.push(String(e.message)));
+main().catch((e) => {
+  view.errors.push(String(e.message || e));
+  status(`error: ${e.message || e}`, true);
+  console.error(e);
+});
