@@ -8,6 +8,7 @@
 
 #include <atomic>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <memory>
 #include <new>
@@ -119,6 +120,8 @@ TEST(MujocoMjcf, EveryShippedRobotMatchesForwardKinematicsAt1000Configurations) 
     }
     EXPECT_LT(worst_p, 1e-9) << name;
     EXPECT_LT(worst_r, 1e-9) << name;
+    std::printf("%s: MuJoCo's t6 against forward(), worst of 1000: %.2g m, %.2g rad\n", name,
+                worst_p, worst_r);
   }
 }
 
@@ -355,6 +358,8 @@ TEST(MujocoArm, AToolPressedOnATableReadsTheTablesReaction) {
   // The tip stands on the table, not in it.
   const double tip = (t6 * math::Vec3{0.0, 0.0, Pressing::kTool}).z;
   EXPECT_NEAR(tip, p.top_z, 0.5e-3);
+  std::printf("pressed with %.1f N: the tip %.3g mm into the table; sensor %.2f N\n", reaction.z,
+              (p.top_z - tip) * 1e3, f_world.z);
 }
 
 TEST(MujocoArm, AGentlePushInZeroGravityReadsThePush) {
