@@ -8,6 +8,7 @@
 
 #include <atomic>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <memory>
 #include <new>
@@ -119,6 +120,8 @@ TEST(MujocoMjcf, EveryShippedRobotMatchesForwardKinematicsAt1000Configurations) 
     }
     EXPECT_LT(worst_p, 1e-9) << name;
     EXPECT_LT(worst_r, 1e-9) << name;
+    std::printf("%s: MuJoCo's t6 against forward(), worst of 1000: %.2g m, %.2g rad\n", name,
+                worst_p, worst_r);
   }
 }
 
@@ -261,8 +264,11 @@ TEST(MujocoArm, AHangingToolReadsItsWeightAtT6) {
     scene.tool_length_m = 0.15;
     scene.base_m = {math::Rot3::rot_z(0.4), {0.1, 0.2, 0.3}};
     const auto arm = make_arm(model, scene);
-    run_for(*arm, 1.0);
     math::Wrench w;
+    // Before the first tick the motors already hold the arm: the weight is there at once.
+    ASSERT_TRUE(arm->wrist_wrench(w));
+    EXPECT_NEAR((arm->site_pose("t6").R * w.force_N).z, -2.0 * 9.81, 0.2) << name;
+    run_for(*arm, 1.0);
     ASSERT_TRUE(arm->wrist_wrench(w));
     const math::Transform t6 = arm->site_pose("t6");
     // The weight, as the tool side exerts it on the arm, about T6 in T6's axes.
@@ -355,6 +361,8 @@ TEST(MujocoArm, AToolPressedOnATableReadsTheTablesReaction) {
   // The tip stands on the table, not in it.
   const double tip = (t6 * math::Vec3{0.0, 0.0, Pressing::kTool}).z;
   EXPECT_NEAR(tip, p.top_z, 0.5e-3);
+  std::printf("pressed with %.1f N: the tip %.3g mm into the table; sensor %.2f N\n", reaction.z,
+              (p.top_z - tip) * 1e3, f_world.z);
 }
 
 TEST(MujocoArm, AGentlePushInZeroGravityReadsThePush) {
@@ -468,6 +476,62 @@ TEST(MujocoPlant, TheMicroboRunsInMujocoBehindTheServoDriver) {
   const rtc::SimulatedRobot plain(kin::builtin_robot("microbo"));
   EXPECT_NE(plain.rcu, nullptr);
   EXPECT_DOUBLE_EQ(plain.period_s(), 0.028);
+}
+
+}  // namespace
+namespace {
+
+// ---- force control over the plant: the acceptance the force layer builds on --------------------
+
+/// A force loop in the test: the vertical slide's goal moves at 2e-5 m/s per N of error in the
+/// table's reaction (5 mm/s down until the first touch), read from the wrist. Returns the
+/// reactions seen from `from_ms` on; joint 1 turns at 0.1 rad/s (the tip slides at 3 cm/s)
+/// from `slide_ms` on when it is >= 0.
+struct ForceLoop {
+  Pressing p{0.002};
+  double lo = 1e9, hi = -1e9, sum = 0;
+  int n = 0;
+
+  void run(int until_ms, int from_ms, int slide_ms) {
+    const double mg = Pressing::kToolMass * 9.81;
+    double goal = p.model.ready()[1];
+    bool touched = false;
+    const double q0 = p.arm->true_position()[0];
+    for (int ms = 0; ms < until_ms; ++ms) {
+      math::Wrench w;
+      (void)p.arm->wrist_wrench(w);
+      const double f = (p.arm->site_pose("t6").R * w.force_N).z + mg;  // the table's reaction
+      if (f > 1.0) touched = true;
+      goal -= touched ? 2e-5 * (5.0 - f) * 1e-3 : 5e-3 * 1e-3;
+      (void)p.arm->command(1, move(goal, 0.0));
+      if (ms == slide_ms) (void)p.arm->command(0, move(q0 + 0.3, 0.1));
+      p.arm->advance_to(p.arm->time_s() + 1e-3);
+      if (ms < from_ms) continue;
+      lo = std::min(lo, f);
+      hi = std::max(hi, f);
+      sum += f;
+      ++n;
+    }
+  }
+};
+
+TEST(MujocoArm, AForceLoopHolds5NSteadyOnTheTable) {
+  ForceLoop loop;
+  loop.run(2000, 1200, -1);
+  EXPECT_NEAR(loop.sum / loop.n, 5.0, 0.05);
+  EXPECT_GT(loop.lo, 4.5);  // within 10 % at every sample
+  EXPECT_LT(loop.hi, 5.5);
+}
+
+// Not yet: sliding at 3 cm/s the contact chatters (with friction 0.5, stick-slip spikes of about
+// 200 N; without friction the tip still leaves the table every 10 ms, its force flicking between
+// 0 and 10 N), though the mean stays 5 N. docs/FORCE.md, "Limits".
+TEST(MujocoArm, DISABLED_AForceLoopHolds5NSteadyWhileSliding) {
+  ForceLoop loop;
+  loop.run(4000, 2000, 1500);
+  EXPECT_NEAR(loop.sum / loop.n, 5.0, 0.5);
+  EXPECT_GT(loop.lo, 4.5);
+  EXPECT_LT(loop.hi, 5.5);
 }
 
 }  // namespace

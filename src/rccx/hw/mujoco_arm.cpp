@@ -79,9 +79,17 @@ MujocoArm::MujocoArm(kin::RobotModel model, const SimulatedArmOptions& options)
   }
   jacp_.assign(3 * static_cast<std::size_t>(m_->nv), 0.0);
   jacr_.assign(3 * static_cast<std::size_t>(m_->nv), 0.0);
+  // Sensors and poses valid before the first tick, with the motors holding against gravity
+  // (at rest, a hanging tool then reads its weight at once).
   write_state();
-  mj_forward(m_, d_);                     // sensors and poses valid before the first tick
-  filtered_wrench_ = raw_wrist_wrench();  // the filter starts settled
+  mj_forward(m_, d_);
+  if (options.powered) {
+    std::array<double, kin::kMaxJoints> hold{};
+    compute_gravity_load(hold);
+    for (std::size_t i = 0; i < n_; ++i) d_->ctrl[actuator_[i]] = hold[i];
+    mj_forward(m_, d_);
+  }
+  filtered_wrench_ = raw_wrist_wrench();  // the sensor's filter starts settled
 }
 
 MujocoArm::~MujocoArm() {
