@@ -499,7 +499,7 @@ struct ForceLoop {
     const double q0 = p.arm->true_position()[0];
     for (int ms = 0; ms < until_ms; ++ms) {
       math::Wrench w;
-      (void)p.arm->wrist_wrench(w);
+      w = p.arm->raw_wrist_wrench();  // the plant's own load, not the sensor's filtered one
       const double f = (p.arm->site_pose("t6").R * w.force_N).z + mg;  // the table's reaction
       if (f > 1.0) touched = true;
       goal -= touched ? 2e-5 * (5.0 - f) * 1e-3 : 5e-3 * 1e-3;
