@@ -56,8 +56,12 @@ int main(int argc, char** argv) {
   table.name = "table";
   table.half_size_m = {0.40, 0.40, 0.02};
   table.pose_m = Transform::translation(0.45, 0.0, table_mm * 1e-3 - 0.02);
-  table.friction = 0.3;
+  table.friction = 0.2;
   scene->boxes.push_back(table);
+  // A tool with some give (a 20 ms contact, MuJoCo's default, not steel on steel) and modest
+  // friction: what force control through position servos sampled at 10 ms wants (FORCE.md).
+  scene->contact_time_constant_s = 0.02;
+  scene->tool_friction = 0.2;
   scene->tool_mass_kg = kToolMass_kg;
   scene->tool_com_m = {0, 0, kToolLength_m / 2};
   scene->tool_length_m = kToolLength_m;
@@ -97,7 +101,7 @@ int main(int argc, char** argv) {
   // 1. Touch.
   wait(arm.move(above));
   arm.set_mode(rccl::Mode::cartesian);
-  arm.set_velocity(20_mm, 30_deg);
+  arm.set_velocity(5_mm, 30_deg);  // a search: slowly (FORCE.md)
   rccl::ForceGuard guard;
   guard.kind = rccl::ForceGuard::Kind::along;
   guard.axis = 2;  // the tool's z
@@ -121,6 +125,7 @@ int main(int argc, char** argv) {
   press.axes = 1U << 2;
   press.force[2] = press_N;
   arm.set_compliance(press);
+  arm.set_velocity(20_mm, 30_deg);
   const rccl::Motion wipe = arm.move(spot("ALONG", 550, 100, 0));
   double lo = 1e9, hi = -1e9, sum = 0.0;
   int n = 0;
