@@ -795,6 +795,26 @@ int stop(double ms) {
   return code;
 }
 
+extern "C++" {
+namespace {
+/// Calls take(word) for each word of `text` (separated by spaces, commas or tabs; empty words
+/// too, which take() skips): the argument strings of distance(), comply() and limit().
+template <class F>
+void for_each_word(const std::string& text, F&& take) {
+  std::string word;
+  for (const char c : text) {
+    if (c == ' ' || c == ',' || c == '\t') {
+      take(word);
+      word.clear();
+    } else {
+      word += c;
+    }
+  }
+  take(word);
+}
+}  // namespace
+}
+
 int distance(const char* what, ...) {
   std::va_list ap;
   va_start(ap, what);
@@ -816,7 +836,6 @@ int distance(const char* what, ...) {
     math::Transform trans = math::Transform::identity();
     math::Rot3 rotation = math::Rot3::identity();
     std::size_t k = 0;
-    std::string word;
     const auto take = [&](const std::string& w) {
       if (w.empty()) return;
       const double v = values[k++];
@@ -847,15 +866,7 @@ int distance(const char* what, ...) {
       return fail(RTC_E_ARGUMENT, fmt::format("distance(\"{}\"): at most 15 displacements", text),
                   Say::print);
     }
-    for (const char c : text) {
-      if (c == ' ' || c == ',' || c == '\t') {
-        take(word);
-        word.clear();
-      } else {
-        word += c;
-      }
-    }
-    take(word);
+    for_each_word(text, take);
     if (k == 0) {
       return fail(RTC_E_ARGUMENT, "distance: no displacement given; e.g. distance(\"dz\", -30.)",
                   Say::print);
@@ -1020,7 +1031,6 @@ std::vector<std::pair<std::size_t, double>> force_words(const char* call, const 
                                                         bool with_values) {
   std::vector<std::pair<std::size_t, double>> out;
   std::size_t k = 0;
-  std::string word;
   const auto take = [&](const std::string& w) {
     if (w.empty()) return;
     std::size_t axis = 6;  // "f": the force's magnitude (limit only)
@@ -1045,15 +1055,7 @@ std::vector<std::pair<std::size_t, double>> force_words(const char* call, const 
     }
     out.emplace_back(axis, v);
   };
-  for (const char c : text) {
-    if (c == ' ' || c == ',' || c == '\t') {
-      take(word);
-      word.clear();
-    } else {
-      word += c;
-    }
-  }
-  take(word);
+  for_each_word(text, take);
   if (out.empty()) {
     throw std::invalid_argument(
         fmt::format("{}: no axis given; e.g. {}(\"fz\"{})", call, call, with_values ? ", 5." : ""));
