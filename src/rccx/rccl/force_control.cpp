@@ -20,14 +20,13 @@ math::Transform offset_frame(const std::array<double, 6>& x) noexcept {
 
 }  // namespace
 
+// The planning side writes only the pending copies (the loop's own are never read here).
 void ForceControl::set_tool_load(const force::ToolLoad& load) noexcept {
   pending_load_ = load;
-  pending_world_ = world_from_base_;
   load_changed_.store(true, std::memory_order_release);
 }
 
 void ForceControl::set_world_from_base(const math::Rot3& r) noexcept {
-  pending_load_ = load_;
   pending_world_ = r;
   load_changed_.store(true, std::memory_order_release);
 }
@@ -73,7 +72,7 @@ void ForceControl::record_contact(std::uint64_t id, const ForceGuard& g,
   contacts_[id % kContacts] = c;
 }
 
-bool ForceControl::comply(const Compliance& c, double dt) noexcept {
+void ForceControl::comply(const Compliance& c, double dt) noexcept {
   const std::array<double, 6> f = applied_.to_array();
   for (std::size_t i = 0; i < 6; ++i) {
     const bool force_axis = i < 3;
@@ -94,7 +93,6 @@ bool ForceControl::comply(const Compliance& c, double dt) noexcept {
     // The last bit of a returning offset: done (an exponential never reaches zero).
     if (!c.compliant(i) && std::abs(offset_[i]) < (force_axis ? 1e-7 : 1e-6)) offset_[i] = 0.0;
   }
-  return true;
 }
 
 ForceControl::Outcome ForceControl::apply_offset(const math::Transform& tool,
@@ -180,7 +178,7 @@ ForceControl::Outcome ForceControl::step(const rtc::How& how, std::uint64_t id,
       return Outcome::overload;
     }
   }
-  (void)comply(c, period_s);
+  comply(c, period_s);
   const Outcome o = apply_offset(tool, q);
   if (o == Outcome::unreachable) {
     held_for_ = id;

@@ -82,7 +82,7 @@ class ForceControl {
   void record_contact(std::uint64_t id, const ForceGuard& g, const math::Transform& tool) noexcept;
   /// Moves the offset one sample (dt, s) by the admittance along compliant axes, back to the
   /// path along locked ones.
-  bool comply(const Compliance& c, double dt) noexcept;
+  void comply(const Compliance& c, double dt) noexcept;
   /// Moves setpoint q by the offset in the tool frame (unreachable: q stays on the path's
   /// last followable offset).
   Outcome apply_offset(const math::Transform& tool, kin::JointVector& q) noexcept;
