@@ -12,11 +12,13 @@
 #include <cstdlib>
 #include <memory>
 #include <new>
+#include <numbers>
 #include <random>
 #include <string>
 
 #include "rccx/hw/mjcf.hpp"
 #include "rccx/hw/mujoco_arm.hpp"
+#include "rccx/hw/rcu.hpp"
 #include "rccx/hw/simulated_arm.hpp"
 #include "rccx/kinematics/kinematics.hpp"
 #include "rccx/math/units.hpp"
@@ -428,6 +430,90 @@ TEST(MujocoArm, AServoTickAllocatesNothing) {
 
 // ---- which plant
 // ---------------------------------------------------------------------------------
+
+TEST(MujocoPlant, ARobotFileGivesItsSceneUnlessCodeDoes) {
+  // A file that extends the shipped PUMA 560 with the plant, a table and a 2 kg tool.
+  const kin::RobotModel model = kin::parse_robot(
+      R"({"extends": "puma560", "name": "puma560_table", "plant": "mujoco",
+          "hardware": {"mujoco": {
+            "base_m": [0.1, 0.2, 0.3], "base_rpy_deg": [30, 0, 0],
+            "tool": {"mass_kg": 2.0, "com_m": [0, 0, 0.05], "length_m": 0.1},
+            "boxes": [{"name": "table", "center_m": [0.5, 0, -0.3], "rpy_deg": [10, 0, 0],
+                       "half_size_m": [0.3, 0.3, 0.02], "friction": 0.3},
+                      {"name": "cube", "center_m": [0.5, 0, -0.25], "half_size_m": [0.02, 0.02, 0.02],
+                       "mass_kg": 0.1}],
+            "contact_time_constant_s": 0.02, "substeps": 2}}})",
+      "test");
+  EXPECT_FALSE(hw::has_rcu(model));
+  const hw::Scene scene = hw::scene_from_file(model);
+  ASSERT_EQ(scene.boxes.size(), 2U);
+  EXPECT_EQ(scene.boxes[0].name, "table");
+  EXPECT_DOUBLE_EQ(scene.boxes[0].friction, 0.3);
+  EXPECT_DOUBLE_EQ(scene.boxes[1].mass_kg, 0.1);
+  EXPECT_EQ(scene.substeps, 2);
+  EXPECT_DOUBLE_EQ(scene.tool_mass_kg, 2.0);
+
+  const auto arm = hw::make_simulated_arm(model);
+  auto* mj = dynamic_cast<MujocoArm*>(arm.get());
+  ASSERT_NE(mj, nullptr);
+  // The base moved and turned 30 deg, as the file says.
+  const math::Transform base = mj->body_pose("base");
+  EXPECT_LT((base.p - math::Vec3{0.1, 0.2, 0.3}).norm(), 1e-12);
+  EXPECT_NEAR(std::atan2(base.R(1, 0), base.R(0, 0)), 30.0 * std::numbers::pi / 180.0, 1e-12);
+  EXPECT_NE(mj->mjcf().find("name=\"table\""), std::string::npos);
+  EXPECT_NE(mj->mjcf().find("name=\"cube\""), std::string::npos);
+  // The tool's weight is read at the wrist.
+  run_for(*mj, 0.5);
+  math::Wrench w;
+  ASSERT_TRUE(mj->wrist_wrench(w));
+  EXPECT_NEAR((mj->site_pose("t6").R * w.force_N).z, -2.0 * 9.81, 0.05);
+
+  // A scene from code replaces the file's.
+  hw::SimulatedArmOptions o;
+  o.scene = std::make_shared<hw::Scene>();
+  const auto bare = hw::make_simulated_arm(model, o);
+  EXPECT_EQ(dynamic_cast<MujocoArm*>(bare.get())->mjcf().find("name=\"table\""), std::string::npos);
+
+  // The Microbo's file keeps its RCU beside a scene.
+  kin::RobotModel microbo = kin::builtin_robot("microbo");
+  EXPECT_TRUE(hw::has_rcu(microbo));
+  microbo.hardware_json.insert(1, R"("mujoco": {"tool": {"mass_kg": 0.5}}, )");
+  EXPECT_TRUE(hw::has_rcu(microbo));
+  EXPECT_EQ(hw::rcu_config(microbo).joints.size(), 6U);
+  EXPECT_DOUBLE_EQ(hw::scene_from_file(microbo).tool_mass_kg, 0.5);
+}
+
+TEST(MujocoPlant, ABadSceneInTheFileIsRefusedNamingTheKey) {
+  const auto refused = [](const std::string& mujoco, const std::string& says) {
+    kin::RobotModel m = kin::builtin_robot("puma560");
+    m.hardware_json = R"({"mujoco": )" + mujoco + "}";
+    try {
+      (void)hw::scene_from_file(m);
+      ADD_FAILURE() << mujoco << ": accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(says), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("\"mujoco\""), std::string::npos) << e.what();
+    }
+  };
+  refused(R"({"tabel": {}})", "unknown key \"tabel\"");
+  refused(R"({"tool": {"mass_kg": -1}})", "\"mass_kg\" must not be negative");
+  refused(R"({"tool": {"radius_m": 0}})", "\"radius_m\" must be > 0");
+  refused(R"({"boxes": {}})", "\"boxes\" must be a list");
+  refused(R"({"boxes": [{"name": "t", "half_size_m": [0.1, 0, 0.1]}]})", "\"half_size_m\"");
+  refused(R"({"boxes": [{"name": "t", "half_size_m": [0.1, 0.1]}]})", "\"half_size_m\"");
+  refused(R"({"boxes": [{"half_size_m": [0.1, 0.1, 0.1]}]})", "\"name\"");
+  refused(R"({"substeps": 0})", "\"substeps\"");
+  refused(R"({"base_m": [0, 0, "up"]})", "\"base_m\"");
+  // A scene the MJCF cannot take is refused when the plant is made, saying why.
+  kin::RobotModel m = kin::builtin_robot("puma560");
+  m.plant = kin::Plant::mujoco;
+  m.hardware_json = R"({"mujoco": {"contact_time_constant_s": 0.0001}})";
+  EXPECT_THROW((void)hw::make_simulated_arm(m), std::invalid_argument);
+  // Keys beside "rcu" and "mujoco" are refused where the RCU is read too.
+  kin::RobotModel microbo = kin::builtin_robot("microbo");
+  microbo.hardware_json.insert(1, R"("bullet": {}, )");
+  EXPECT_THROW((void)hw::rcu_config(microbo), std::invalid_argument);
+}
 
 TEST(MujocoPlant, ARobotFileChoosesItAndOptionsOverride) {
   kin::RobotModel model = kin::builtin_robot("stanford");

@@ -269,3 +269,51 @@ TEST(RobotFile, ClosedFormsRefuseChainsOfAnotherShape) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST(RobotFile, ExtendsAShippedRobotWithItsOwnKeysOverIt) {
+  const kin::RobotModel base = kin::builtin_robot("puma560");
+  const kin::RobotModel m = kin::parse_robot(
+      R"({"extends": "puma560", "name": "puma560_table", "plant": "mujoco",
+          // a comment, as in any robot file
+          "hardware": {"mujoco": {"substeps": 2}}})",
+      "test");
+  EXPECT_EQ(m.name, "puma560_table");
+  EXPECT_EQ(m.title, base.title);
+  EXPECT_EQ(m.plant, kin::Plant::mujoco);
+  EXPECT_EQ(m.hardware_json, R"({"mujoco":{"substeps":2}})");
+  ASSERT_EQ(m.dof(), base.dof());
+  for (std::size_t i = 0; i < m.dof(); ++i) {
+    EXPECT_EQ(m.joints[i].dh.a_m, base.joints[i].dh.a_m);
+    EXPECT_EQ(m.joints[i].upper, base.joints[i].upper);
+    EXPECT_EQ(m.joints[i].dynamics.inertia, base.joints[i].dynamics.inertia);
+  }
+  // The same kinematics as the robot it extends.
+  const auto k = kin::make_kinematics(m), kb = kin::make_kinematics(base);
+  const kin::JointVector q = base.ready();
+  EXPECT_LT((k->forward(q).p - kb->forward(q).p).norm(), 1e-15);
+
+  // A joint list given replaces the whole list (a merge patch): one joint is a 1-joint robot.
+  const kin::RobotModel one = kin::parse_robot(
+      R"({"extends": "stanford", "name": "one", "solver": "dh", "joints": [
+          {"name": "q1", "type": "revolute", "a_m": 0.1, "alpha_deg": 0, "d_m": 0,
+           "theta_deg": 0, "lower_deg": -90, "upper_deg": 90,
+           "resolution_deg_per_count": 0.01, "ready_deg": 0, "max_velocity_deg_per_s": 90}]})",
+      "test");
+  EXPECT_EQ(one.dof(), 1U);
+
+  // What is merged is checked as any file is: an unknown key, a name that is no robot.
+  EXPECT_THROW((void)kin::parse_robot(R"({"extends": "puma560", "colour": "red"})", "t"),
+               kin::RobotFileError);
+  try {
+    (void)kin::parse_robot(R"({"extends": "puma600"})", "t");
+    ADD_FAILURE() << "an unknown robot was extended";
+  } catch (const kin::RobotFileError& e) {
+    EXPECT_NE(std::string(e.what()).find("puma560"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("\"extends\""), std::string::npos) << e.what();
+  }
+  EXPECT_THROW((void)kin::parse_robot(R"({"extends": 3})", "t"), kin::RobotFileError);
+}
+
+}  // namespace

@@ -10,13 +10,15 @@
 #include "rccx/hw/arm_base.hpp"
 #include "rccx/hw/gravity.hpp"
 #include "rccx/hw/rcu.hpp"
+#include "rccx/io/json_reader.hpp"
+#include "rccx/math/units.hpp"
 
 namespace rccx::hw {
 
 std::array<JointPlant, kin::kMaxJoints> joint_plants(const kin::RobotModel& model) {
   std::array<JointPlant, kin::kMaxJoints> out{};
   RcuConfig rcu;
-  if (!model.hardware_json.empty()) rcu = rcu_config(model);
+  if (has_rcu(model)) rcu = rcu_config(model);
   const std::size_t n = std::min(model.dof(), kin::kMaxJoints);
   for (std::size_t i = 0; i < n; ++i) {
     const kin::Joint& j = model.joints[i];
@@ -106,6 +108,72 @@ void indent(std::string& out, std::size_t depth) {
 }
 
 }  // namespace
+
+namespace {
+
+using SceneReader = io::JsonObjectReader<std::invalid_argument>;
+
+math::Vec3 vec3(SceneReader& r, const std::string& key, const math::Vec3& fallback) {
+  if (!r.has(key)) return fallback;
+  const auto v = r.numbers<3>(key, 1e3);
+  return {v[0], v[1], v[2]};
+}
+
+math::Rot3 rpy_deg(SceneReader& r, const std::string& key) {
+  if (!r.has(key)) return math::Rot3::identity();
+  const auto v = r.numbers<3>(key, 360.0);
+  return math::Rot3::from_rpy(math::deg_to_rad(v[0]), math::deg_to_rad(v[1]),
+                              math::deg_to_rad(v[2]));
+}
+
+}  // namespace
+
+Scene scene_from_file(const kin::RobotModel& model) {
+  Scene scene;
+  if (model.hardware_json.empty()) return scene;
+  nlohmann::json doc;
+  try {
+    doc = nlohmann::json::parse(model.hardware_json, nullptr, true, true);
+  } catch (const nlohmann::json::exception& e) {
+    throw std::invalid_argument(fmt::format("{}: \"hardware\": {}", model.name, e.what()));
+  }
+  if (!doc.is_object() || !doc.contains("mujoco")) return scene;
+  SceneReader r(doc.at("mujoco"), fmt::format("{}: \"hardware\": \"mujoco\"", model.name));
+  scene.base_m = {rpy_deg(r, "base_rpy_deg"), vec3(r, "base_m", {})};
+  if (r.has("tool")) {
+    SceneReader t(r.get("tool"), r.where() + ": \"tool\"");
+    scene.tool_mass_kg = t.non_negative_or("mass_kg", 0.0);
+    scene.tool_com_m = vec3(t, "com_m", {});
+    scene.tool_length_m = t.non_negative_or("length_m", 0.0);
+    scene.tool_radius_m = t.number_or("radius_m", scene.tool_radius_m);
+    if (!(scene.tool_radius_m > 0)) t.fail("\"radius_m\" must be > 0");
+    scene.tool_friction = t.non_negative_or("friction", scene.tool_friction);
+    t.no_unknown_keys();
+  }
+  if (r.has("boxes")) {
+    const nlohmann::json& boxes = r.get("boxes");
+    if (!boxes.is_array()) r.fail("\"boxes\" must be a list of objects");
+    for (std::size_t i = 0; i < boxes.size(); ++i) {
+      SceneReader b(boxes[i], fmt::format("{}: \"boxes\" [{}]", r.where(), i + 1));
+      SceneBox box;
+      box.name = b.name("name", 64);
+      box.pose_m = {rpy_deg(b, "rpy_deg"), vec3(b, "center_m", {})};
+      box.half_size_m = vec3(b, "half_size_m", {});
+      if (!(box.half_size_m.x > 0 && box.half_size_m.y > 0 && box.half_size_m.z > 0)) {
+        b.fail("\"half_size_m\" must be three numbers > 0");
+      }
+      box.mass_kg = b.non_negative_or("mass_kg", 0.0);
+      box.friction = b.non_negative_or("friction", box.friction);
+      b.no_unknown_keys();
+      scene.boxes.push_back(std::move(box));
+    }
+  }
+  scene.contact_time_constant_s =
+      r.number_or("contact_time_constant_s", scene.contact_time_constant_s);
+  scene.substeps = static_cast<int>(r.integer_or("substeps", 1, 100, scene.substeps));
+  r.no_unknown_keys();
+  return scene;
+}
 
 std::string make_mjcf(const kin::RobotModel& model, const Scene& scene) {
   const std::size_t n = model.dof();

@@ -86,6 +86,23 @@ inline constexpr double kLinkRadius_m = 0.03;
 /// block.
 std::array<JointPlant, kin::kMaxJoints> joint_plants(const kin::RobotModel& model);
 
+/// The scene a robot file gives its MuJoCo plant, so that a program that only names a file (a C
+/// program, `rccx` commands) can have a table and a tool. In the file's "hardware" block:
+///
+///   "mujoco": {
+///     "base_m": [0, 0, 0], "base_rpy_deg": [0, 0, 0],      the base in the world
+///     "tool": {"mass_kg": 0.4, "com_m": [0, 0, 0.05], "length_m": 0.1, "radius_m": 0.008,
+///              "friction": 0.2},
+///     "boxes": [{"name": "table", "center_m": [0.5, 0, -0.22], "rpy_deg": [0, 0, 0],
+///                "half_size_m": [0.4, 0.4, 0.02], "mass_kg": 0, "friction": 0.5}],
+///     "contact_time_constant_s": 0.02, "substeps": 1
+///   }
+///
+/// Turns are Paul's roll, pitch, yaw in degrees, as in cell files: Rot(z, roll) Rot(y, pitch)
+/// Rot(x, yaw). Every key is optional (Scene's defaults). An empty Scene when the file has no such block.
+/// Throws std::invalid_argument naming the key for a bad value or an unknown key.
+Scene scene_from_file(const kin::RobotModel& model);
+
 /// The MJCF of `model` in `scene`. Names: bodies "base", "link1" .. "link<dof>", "tool", the
 /// boxes' names; joints "j1" ...; motors "m1" ...; sites "t6" (T6) and "ft" (the sensor, at T6
 /// on the tool body); sensors "ft_force" and "ft_torque". Throws std::invalid_argument for a

@@ -48,7 +48,8 @@ math::Transform from_mujoco(const mjtNum* pos, const mjtNum* mat) {
 }  // namespace
 
 MujocoArm::MujocoArm(kin::RobotModel model, const SimulatedArmOptions& options)
-    : ArmBase(std::move(model), options), scene_(options.scene ? *options.scene : Scene{}) {
+    : ArmBase(std::move(model), options),
+      scene_(options.scene ? *options.scene : scene_from_file(this->model())) {
   const kin::RobotModel& rm = this->model();
   mjcf_ = make_mjcf(rm, scene_);
   plants_ = joint_plants(rm);

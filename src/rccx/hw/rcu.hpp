@@ -192,6 +192,10 @@ struct RcuConfig {
 
 /// Reads the RCU block of a robot file; throws std::invalid_argument naming the key.
 RcuConfig rcu_config(const kin::RobotModel& model);
+/// Whether the robot file describes an RCU ("hardware": {"rcu": ...}): the Microbo's. False for
+/// no "hardware" block, or one with only a MuJoCo scene; throws std::invalid_argument for a
+/// "hardware" block that is not JSON.
+bool has_rcu(const kin::RobotModel& model);
 
 /// Faults the emulator can inject (beyond SimulatedArm's): the joint stops answering (its
 /// registers stay busy), its encoder errs (status bit 6, counts jump), a phase error (bit 5),

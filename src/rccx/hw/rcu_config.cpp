@@ -150,19 +150,33 @@ RcuJointConfig parse_joint(const json& object, const kin::Joint& joint, const st
 
 }  // namespace
 
+namespace {
+
+json parse_hardware(const kin::RobotModel& model) {
+  try {
+    return json::parse(model.hardware_json, nullptr, true, true);
+  } catch (const json::exception& e) {
+    throw std::invalid_argument(fmt::format("{}: \"hardware\": {}", model.name, e.what()));
+  }
+}
+
+}  // namespace
+
+bool has_rcu(const kin::RobotModel& model) {
+  if (model.hardware_json.empty()) return false;
+  const json doc = parse_hardware(model);
+  return doc.is_object() && doc.contains("rcu");
+}
+
 RcuConfig rcu_config(const kin::RobotModel& model) {
   if (model.hardware_json.empty()) {
     throw std::invalid_argument(
         fmt::format("{}: the robot file has no \"hardware\": {{\"rcu\": ...}} block", model.name));
   }
-  json doc;
-  try {
-    doc = json::parse(model.hardware_json, nullptr, true, true);
-  } catch (const json::exception& e) {
-    throw std::invalid_argument(fmt::format("{}: \"hardware\": {}", model.name, e.what()));
-  }
+  const json doc = parse_hardware(model);
   Reader hardware(doc, fmt::format("{}: \"hardware\"", model.name));
   Reader r(hardware.get("rcu"), fmt::format("{}: \"hardware\": \"rcu\"", model.name));
+  (void)hardware.has("mujoco");  // the MuJoCo plant's scene (scene_from_file) reads it
   hardware.no_unknown_keys();
 
   RcuConfig config;

@@ -72,7 +72,8 @@ struct SimulatedArmOptions {
   /// The plant; automatic: the robot file's "plant", and when that is automatic too, the
   /// simulated PUMA or the ideal servo as make_simulated_arm says.
   Plant plant = Plant::automatic;
-  /// What surrounds a MuJoCo arm (the table, objects, the tool, the base's place); null: nothing,
+  /// What surrounds a MuJoCo arm (the table, objects, the tool, the base's place); null: the
+  /// robot file's scene ("hardware": {"mujoco": ...}, hw::scene_from_file), else nothing and
   /// the base at the world's origin. Other plants ignore it.
   std::shared_ptr<const Scene> scene;
 };

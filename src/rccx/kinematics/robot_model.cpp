@@ -184,6 +184,28 @@ namespace {
 /// overflow the stack.
 constexpr int kMaxDepth = 32;
 
+/// A file that "extends" a shipped robot: the shipped file with the file's keys put over it
+/// (RFC 7386 merge: an object merges key by key, anything else, a list of joints too, replaces),
+/// so that a cell's robot file says only what differs (its plant, its scene, its name).
+json extended(json doc, std::string_view origin) {
+  const json& base_name = doc.at("extends");
+  if (!base_name.is_string()) {
+    throw RobotFileError(fmt::format("{}: \"extends\" must name a shipped robot ({})", origin,
+                                     fmt::join(builtin_robot_names(), ", ")));
+  }
+  const std::string name = base_name.get<std::string>();
+  for (const auto& robot : detail::embedded_robots()) {
+    if (robot.file_name.substr(0, robot.file_name.rfind('.')) != name) continue;
+    json base = json::parse(robot.text, nullptr, true, /*ignore_comments=*/true);
+    doc.erase("extends");
+    base.merge_patch(doc);
+    return base;
+  }
+  throw RobotFileError(fmt::format("{}: \"extends\": no shipped robot named {}; known robots: {}",
+                                   origin, io::quoted(name),
+                                   fmt::join(builtin_robot_names(), ", ")));
+}
+
 RobotModel parse_robot_json(std::string_view json_text, std::string_view origin) {
   json doc;
   std::vector<std::set<std::string>> keys;  // one set per open object
@@ -207,6 +229,7 @@ RobotModel parse_robot_json(std::string_view json_text, std::string_view origin)
   } catch (const json::exception& e) {  // syntax, or a number that overflows a double
     throw RobotFileError(fmt::format("{}: not valid JSON: {}", origin, e.what()));
   }
+  if (doc.is_object() && doc.contains("extends")) doc = extended(std::move(doc), origin);
   Reader r(doc, std::string(origin));
   RobotModel model;
   model.name = r.name("name");

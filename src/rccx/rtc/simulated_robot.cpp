@@ -1,5 +1,6 @@
 #include "rccx/rtc/simulated_robot.hpp"
 
+#include "rccx/hw/rcu.hpp"
 #include "rccx/rtc/microbo_driver.hpp"
 #include "rccx/rtc/servo_driver.hpp"
 
@@ -9,8 +10,7 @@ namespace {
 
 /// The RCU serves a robot whose file describes one, unless a plant is named.
 bool behind_rcu(const kin::RobotModel& model, hw::Plant plant) {
-  return !model.hardware_json.empty() && plant == hw::Plant::automatic &&
-         model.plant == hw::Plant::automatic;
+  return hw::has_rcu(model) && plant == hw::Plant::automatic && model.plant == hw::Plant::automatic;
 }
 
 }  // namespace
