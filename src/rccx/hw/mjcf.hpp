@@ -99,8 +99,8 @@ std::array<JointPlant, kin::kMaxJoints> joint_plants(const kin::RobotModel& mode
 ///   }
 ///
 /// Turns are Paul's roll, pitch, yaw in degrees, as in cell files: Rot(z, roll) Rot(y, pitch)
-/// Rot(x, yaw). Every key is optional (Scene's defaults). An empty Scene when the file has no such block.
-/// Throws std::invalid_argument naming the key for a bad value or an unknown key.
+/// Rot(x, yaw). Every key is optional (Scene's defaults). An empty Scene when the file has no such
+/// block. Throws std::invalid_argument naming the key for a bad value or an unknown key.
 Scene scene_from_file(const kin::RobotModel& model);
 
 /// The MJCF of `model` in `scene`. Names: bodies "base", "link1" .. "link<dof>", "tool", the
