@@ -24,6 +24,10 @@
 #include "rccx/view/server.hpp"
 #include "shell_run.hpp"
 
+#ifdef RCCX_HAVE_RSVG
+#include <cairo.h>
+#endif
+
 namespace {
 
 using namespace rccx;
@@ -285,21 +289,23 @@ TEST(RunLog, ReplayRefusesALogOfAnotherRobot) {
                view::RunLogError);
 }
 
+/// A recorded run of the PUMA (RCCX_LOG's format, through SampleLog itself) in `file`.
+void record_puma_run(const std::filesystem::path& file) {
+  rtc::SimulatedRobotOptions options;
+  options.log = file;
+  rtc::SimulatedRobot robot(kin::builtin_robot("puma560"), options);
+  rccl::Manipulator arm(*robot.session);
+  arm.start();
+  kin::JointVector q = robot.model.ready();
+  q[0] += 0.3;
+  arm.waitfor(arm.move(rccl::Position::joints("A", q)).end());
+  arm.stop_control();
+  EXPECT_EQ(robot.finish(), "");
+}
+
 TEST(Plot, DrawsTheFourPanels) {
-  // A recorded run of the PUMA (RCCX_LOG's format, through SampleLog itself).
   const auto file = std::filesystem::temp_directory_path() / "rccx_view_test_run.csv";
-  {
-    rtc::SimulatedRobotOptions options;
-    options.log = file;
-    rtc::SimulatedRobot robot(kin::builtin_robot("puma560"), options);
-    rccl::Manipulator arm(*robot.session);
-    arm.start();
-    kin::JointVector q = robot.model.ready();
-    q[0] += 0.3;
-    arm.waitfor(arm.move(rccl::Position::joints("A", q)).end());
-    arm.stop_control();
-    EXPECT_EQ(robot.finish(), "");
-  }
+  record_puma_run(file);
   const view::RunLog log = view::load_run_log(file);
   const std::string svg = view::plot_svg(log, kin::builtin_robot("puma560"), "a <test> run");
   EXPECT_EQ(svg.rfind("<svg", 0), 0U);
@@ -328,14 +334,69 @@ TEST(ViewCli, BadInputExitsTwoWithWhatToDo) {
   EXPECT_NE(r.out.find("--log: "), std::string::npos) << r.out;
 
   std::ofstream(dir / "good.csv") << kGoodLog;
-  r = test::rccx_run(fmt::format("plot {}/good.csv -o {}/out.png", dir.string(), dir.string()));
+  r = test::rccx_run(fmt::format("plot {}/good.csv -o {}/out.pdf", dir.string(), dir.string()));
   EXPECT_EQ(r.exit_code, 2);
-  EXPECT_NE(r.out.find("name the file *.svg"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("out.pdf: rccx plot writes SVG or PNG; name the file *.svg or *.png"),
+            std::string::npos)
+      << r.out;
+  EXPECT_FALSE(std::filesystem::exists(dir / "out.pdf"));
 
   view::Server taken(view::Scene::of_robot(kin::builtin_robot("microbo")), 0, quiet());
   r = test::rccx_run(fmt::format("view --robot microbo --port {} --seconds 1", taken.port()));
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.out.find("is in use"), std::string::npos) << r.out;
+  std::filesystem::remove_all(dir);
+}
+
+/// Big-endian 32 bits at `at` of `s`.
+std::uint32_t be32(const std::string& s, std::size_t at) {
+  std::uint32_t v = 0;
+  for (std::size_t i = 0; i < 4; ++i) v = (v << 8) | static_cast<unsigned char>(s.at(at + i));
+  return v;
+}
+
+TEST(ViewCli, PlotWritesPng) {
+  const auto dir = std::filesystem::temp_directory_path() / "rccx_view_cli_png_test";
+  std::filesystem::create_directories(dir);
+  const auto run = dir / "run.csv";
+  record_puma_run(run);
+  const auto png = dir / "out.png";
+  const auto r =
+      test::rccx_run(fmt::format("plot {} --robot puma560 -o {}", run.string(), png.string()));
+#ifdef RCCX_HAVE_RSVG
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  std::ifstream in(png, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ASSERT_GE(bytes.size(), 33U);
+  EXPECT_EQ(bytes.substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8));
+  EXPECT_EQ(bytes.substr(12, 4), "IHDR");  // the first chunk: width, height
+  EXPECT_EQ(be32(bytes, 16), 1200U);
+  EXPECT_EQ(be32(bytes, 20), 900U);
+  // Decoded, it is a plot: most pixels the white background, some the lines and text.
+  cairo_surface_t* image = cairo_image_surface_create_from_png(png.c_str());
+  ASSERT_EQ(cairo_surface_status(image), CAIRO_STATUS_SUCCESS);
+  // Opaque: cairo writes it as RGB and reads it back as RGB24 (the top byte unused).
+  const cairo_format_t format = cairo_image_surface_get_format(image);
+  ASSERT_TRUE(format == CAIRO_FORMAT_RGB24 || format == CAIRO_FORMAT_ARGB32) << format;
+  const int w = cairo_image_surface_get_width(image), h = cairo_image_surface_get_height(image);
+  const int stride = cairo_image_surface_get_stride(image);
+  const unsigned char* data = cairo_image_surface_get_data(image);
+  std::size_t white = 0, other = 0;
+  for (int y = 0; y < h; ++y) {
+    const auto* row =
+        reinterpret_cast<const std::uint32_t*>(data + static_cast<std::ptrdiff_t>(y) * stride);
+    for (int x = 0; x < w; ++x) ((row[x] & 0xffffffU) == 0xffffffU ? white : other)++;
+  }
+  cairo_surface_destroy(image);
+  const double total = static_cast<double>(w) * h;
+  EXPECT_GT(static_cast<double>(white) / total, 0.5) << "the background is white";
+  EXPECT_GT(static_cast<double>(other) / total, 0.01) << "lines and text are drawn";
+#else
+  // Built without librsvg: -o FILE.png says how to get it, and writes nothing.
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.out.find("install librsvg2-dev"), std::string::npos) << r.out;
+  EXPECT_FALSE(std::filesystem::exists(png));
+#endif
   std::filesystem::remove_all(dir);
 }
 
