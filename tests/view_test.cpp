@@ -17,6 +17,8 @@
 #include <nlohmann/json.hpp>
 #include <thread>
 
+#include "rccx/cell/cell.hpp"
+#include "rccx/kinematics/kinematics.hpp"
 #include "rccx/rccl/manipulator.hpp"
 #include "rccx/rtc/simulated_robot.hpp"
 #include "rccx/view/plot.hpp"
@@ -231,6 +233,117 @@ TEST(ViewServer, DetachesFromTheSessionWhileItRuns) {
     EXPECT_EQ(robot.session->termination().code, rtc::TerminateCode::overrun)
         << rtc::to_string(robot.session->termination().code);
   }
+}
+
+/// The frame of `scene` named `name`, or null.
+const json* frame_named(const json& scene, const std::string& name) {
+  for (const json& f : scene["frames"]) {
+    if (f["name"] == name) return &f;
+  }
+  return nullptr;
+}
+
+/// The position part of a transform as the page takes it (column-major 4 x 4).
+math::Vec3 position_of(const json& pose) {
+  return {pose[12].get<double>(), pose[13].get<double>(), pose[14].get<double>()};
+}
+
+TEST(ViewServer, ShowsTheGoalOfEachMoveOfAnAttachedArmWithoutShow) {
+  rtc::SimulatedRobot robot(kin::builtin_robot("puma560"));
+  rccl::Manipulator arm(*robot.session);
+  auto server = view::serve(arm, 0, quiet());
+  const std::uint16_t port = server->port();
+  arm.start();
+  arm.set_velocity(0.05, 0.3);  // slow enough that each motion is seen running
+  const auto kinematics = kin::make_kinematics(robot.model);
+  kin::JointVector qa = robot.model.ready();
+  qa[0] += 0.3;
+  kin::JointVector qb = qa;
+  qb[0] -= 0.3;
+  qb[4] += 0.2;
+  const math::Transform tb = kinematics->forward(qb);
+  const auto t6 = rccl::t6();
+  const auto a = rccl::Position::joints("A", qa);
+  const auto b = rccl::Position::make("B", {t6}, {rccl::constant("GB", tb)}, t6);
+  EXPECT_TRUE(json::parse(request(port, "/api/scene").body)["frames"].empty());
+
+  const rccl::Motion ma = arm.move(a);
+  const rccl::Motion mb = arm.move(b);
+  json scene = json::parse(request(port, "/api/scene").body);
+  EXPECT_EQ(scene["frames"].size(), 2U) << scene["frames"].dump();
+  const json* fa = frame_named(scene, "A");
+  const json* fb = frame_named(scene, "B");
+  ASSERT_TRUE(fa != nullptr && fb != nullptr) << scene["frames"].dump();
+  EXPECT_EQ((*fa)["robot"], 0);
+  EXPECT_LT((position_of((*fa)["pose"]) - kinematics->forward(qa).p).norm(), 1e-9);
+  EXPECT_LT((position_of((*fb)["pose"]) - tb.p).norm(), 1e-9);
+  EXPECT_NE((*fb)["note"].get<std::string>().find("GB"), std::string::npos) << (*fb)["note"];
+
+  // The samples of each motion name the goal it goes to.
+  const auto goal_now = [&] {
+    std::this_thread::sleep_for(150ms);  // the server thread drains every 20 ms
+    const json latest = json::parse(request(port, "/api/state").body)["robots"][0];
+    return latest.value("goal", std::string("(none)"));
+  };
+  ASSERT_EQ(arm.waitfor(ma.start()), rccl::WaitResult::reached);
+  robot.session->wait_for(100ms);
+  ASSERT_FALSE(arm.happened(ma.end()));
+  EXPECT_EQ(goal_now(), "A");
+  ASSERT_EQ(arm.waitfor(mb.start()), rccl::WaitResult::reached);
+  robot.session->wait_for(100ms);
+  ASSERT_FALSE(arm.happened(mb.end()));
+  EXPECT_EQ(goal_now(), "B");
+  ASSERT_EQ(arm.waitfor(rccl::Manipulator::completed()), rccl::WaitResult::reached);
+
+  // The same position again is the same frame; a refused move shows nothing.
+  arm.move(a);
+  kin::JointVector far = qa;
+  far[0] = robot.model.joints[0].upper + 1.0;
+  EXPECT_THROW(arm.move(rccl::Position::joints("OUT", far)), rccl::MotionError);
+  scene = json::parse(request(port, "/api/scene").body);
+  EXPECT_EQ(scene["frames"].size(), 2U) << scene["frames"].dump();
+  EXPECT_EQ(frame_named(scene, "OUT"), nullptr);
+
+  // The arm may outlive the view: its observer then does nothing.
+  server.reset();
+  const rccl::Motion again = arm.move(b);
+  EXPECT_EQ(arm.waitfor(again.end()), rccl::WaitResult::reached);
+}
+
+TEST(ViewServer, ACellShowsEachRobotsGoalsWithoutShow) {
+  const auto c = cell::Cell::load(RCCX_CVARL_CELL);
+  c->start();
+  auto server = view::serve(*c, 0, quiet());
+  const std::uint16_t port = server->port();
+  std::vector<rccl::Motion> motions;
+  std::vector<math::Vec3> goals;
+  for (const char* name : {"puma", "microbo"}) {
+    rccl::Manipulator& arm = c->robot(name);
+    arm.set_velocity(0.05, 0.3);
+    kin::JointVector q = arm.kinematics().model().ready();
+    q[3] += 0.3;  // a wrist: the arms keep apart
+    motions.push_back(arm.move(rccl::Position::joints(fmt::format("{}_GOAL", name), q)));
+    goals.push_back((c->base(name) * arm.kinematics().forward(q)).p);
+  }
+  c->wait_for(100ms);
+  std::this_thread::sleep_for(150ms);
+  const json scene = json::parse(request(port, "/api/scene").body);
+  const json state = json::parse(request(port, "/api/state").body);
+  const char* names[] = {"puma", "microbo"};
+  for (int r = 0; r < 2; ++r) {
+    const std::string goal = fmt::format("{}_GOAL", names[r]);
+    const json* f = frame_named(scene, goal);
+    ASSERT_NE(f, nullptr) << scene["frames"].dump();
+    EXPECT_EQ((*f)["robot"], r);
+    EXPECT_LT((position_of((*f)["pose"]) - goals[static_cast<std::size_t>(r)]).norm(), 1e-9);
+    ASSERT_FALSE(c->robot(names[r]).happened(motions[static_cast<std::size_t>(r)].end()));
+    EXPECT_EQ(state["robots"][r].value("goal", std::string("(none)")), goal);
+  }
+  // One robot's page lists its own goals, not the other's.
+  const json microbo = json::parse(request(port, "/api/scene?robot=microbo").body);
+  EXPECT_NE(frame_named(microbo, "microbo_GOAL"), nullptr);
+  EXPECT_EQ(frame_named(microbo, "puma_GOAL"), nullptr);
+  server.reset();  // before the cell's sessions
 }
 
 constexpr const char* kGoodLog =
