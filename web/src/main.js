@@ -271,7 +271,7 @@ function addFrame(f, robotNames) {
     const axes = new THREE.AxesHelper(0.06);
     axes.matrixAutoUpdate = false;
     scene.add(axes);
-    const text = f.robot >= 0 && robotNames.length > 1 ? `${robotNames[f.robot]}: ${f.name}` : f.name;
+    const text = f.robot >= 0 && robotNames[f.robot] ? `${robotNames[f.robot]}: ${f.name}` : f.name;
     const l = label(text);
     scene.add(l);
     entry = { axes, label: l, pose: null };
@@ -441,8 +441,9 @@ async function main() {
   }
   const robots = new Map();
   desc.robots.forEach((r, i) => robots.set(r.index, new RobotView(r, i)));
+  // A goal's label names its robot when the page shows several.
   const robotNames = [];
-  for (const r of desc.robots) robotNames[r.index] = r.name;
+  if (desc.robots.length > 1) for (const r of desc.robots) robotNames[r.index] = r.name;
   desc.objects.forEach(addObject);
   desc.frames.forEach((f) => addFrame(f, robotNames));
   // The camera takes in every robot at its ready pose and the objects.

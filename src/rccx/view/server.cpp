@@ -708,10 +708,8 @@ void Server::attach(std::size_t robot, rccl::Manipulator& arm) {
   if (r.session == nullptr) {
     attach(robot, arm.session());
   } else if (r.session != &arm.session()) {
-    throw ViewError(
-        fmt::format("robot {} of the view is tapped on another session than this "
-                    "arm's",
-                    impl_->scene.robots[robot].name));
+    throw ViewError(fmt::format("robot {} of the view taps another session than this arm's",
+                                impl_->scene.robots[robot].name));
   }
   arm.set_move_observer([goals = std::weak_ptr<Goals>(impl_->goals), robot](
                             const rccl::Motion& m, const rccl::PositionPtr& p) {
