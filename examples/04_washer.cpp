@@ -13,7 +13,8 @@
 //
 // With --view[=PORT] (`make demo-view`) it runs at the pace of the wall clock and serves the view
 // (rccx::view) on 127.0.0.1:PORT (8080): open the address it prints to watch the arm, the window's
-// corners B .. E, the tool path and the plots; it serves until Ctrl-C once the washer is done.
+// corners (P1 .. P4, each drawn as the arm is sent there, the running one marked), the tool path
+// and the plots; it serves until Ctrl-C once the washer is done.
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -58,7 +59,8 @@ int main(int argc, char** argv) {
   std::unique_ptr<view::Server> view;
   if (viewed) {
     try {
-      view = view::serve(*robot.session, static_cast<std::uint16_t>(view_port));
+      // The arm's view: each position moved to is drawn, named, and the running one marked.
+      view = view::serve(arm, static_cast<std::uint16_t>(view_port));
     } catch (const view::ViewError& e) {
       fmt::print(stderr, "04_washer: {}\n", e.what());
       return 2;
@@ -76,9 +78,6 @@ int main(int argc, char** argv) {
   const auto p2 = rccl::Position::make("P2", {t6}, {c}, t6);
   const auto p3 = rccl::Position::make("P3", {t6}, {d}, t6);
   const auto p4 = rccl::Position::make("P4", {t6}, {e}, t6);
-  if (view) {
-    for (const auto& p : {p1, p2, p3, p4}) view->show(p);  // the corners, named
-  }
 
   // waitfor; when watched, simulated time goes at the wall clock's pace: a sample, then its period
   // of sleep (real time would do as well on a quiet machine, but a busy one may overrun).

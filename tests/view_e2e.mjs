@@ -4,15 +4,20 @@
 //      behind the newest; the three plots fill; a second page is open meanwhile; a page for an
 //      unknown robot is a 404 and the server goes on serving;
 //   2. replay: a run recorded with RCCX_LOG, replayed with `rccx view --log`: moving the slider
-//      puts the robot in the logged pose.
-// Screenshots go to ARTIFACT_DIR (view-live.png, view-replay.png).
+//      puts the robot in the logged pose;
+//   3. a cell of two robots (cells/cvarl.json): a selector chooses whose plots are shown; each
+//      robot's plots hold its own samples (the last point plotted is the server's sample of that
+//      robot at that time), the second's as well as the first's; the goals of both robots'
+//      moves are drawn without the program showing them, the running ones marked.
+// Screenshots go to ARTIFACT_DIR (view-live.png, view-replay.png, view-cell.png).
 //
 //   node view_e2e.mjs RCCX ARTIFACT_DIR NODE_MODULES
 // Exit 0 pass, 1 fail, 77 skipped (no chromium or no node_modules: said why).
 import { spawn } from 'node:child_process';
 import { existsSync, mkdirSync, readFileSync } from 'node:fs';
 import { createRequire } from 'node:module';
-import { join, resolve } from 'node:path';
+import { dirname, join, resolve } from 'node:path';
+import { fileURLToPath } from 'node:url';
 
 const [rccx, artifacts, nodeModules] = process.argv.slice(2);
 const chromium = process.env.RCCX_CHROMIUM || '/usr/bin/chromium';
@@ -122,6 +127,9 @@ try {
     `the plots fill (${points.joints} / ${points.cart} / ${points.vel} points)`);
   const moved = await page.evaluate(() => window.rccxView.robots[0].q);
   check(moved.some((q) => Number.isFinite(q)), 'the robot is drawn');
+  const goals = await page.evaluate(() => window.rccxView.frameNames);
+  check(goals.includes('0:P1') && goals.includes('0:P2'),
+    `the goals of the moves are drawn though the program never calls show() (${goals.join(', ')})`);
 
   // Bad input: an unknown robot is a 404 that says which robots there are; the server goes on.
   const bad = await browser.newPage();
@@ -181,6 +189,55 @@ try {
   await rpage.screenshot({ path: join(artifacts, 'view-replay.png') });
   check(rerrors.length === 0, `no console error in the replay (${rerrors.join('; ') || 'none'})`);
   await stop(replay.proc);
+
+  // --- 3. A cell of two robots --------------------------------------------------------------
+  const cellFile = resolve(dirname(fileURLToPath(import.meta.url)), '..', 'cells', 'cvarl.json');
+  const cell = await start(['view', '--cell', cellFile, '--port', '0', '--seconds', '120']);
+  procs.push(cell.proc);
+  const cerrors = [];
+  const cpage = await openPage(browser, cell.url, cerrors);
+  const cscene = await (await fetch(`${cell.url}api/scene`)).json();
+  const names = cscene.robots.map((r) => r.name);
+  check(names.length === 2, `the cell has two robots (${names.join(', ')})`);
+  const options = await cpage.$$eval('#plot-robot option', (os) => os.map((o) => o.textContent));
+  check(await cpage.isVisible('#plot-robot') && options.join() === names.join(),
+    `a selector chooses whose plots are shown (${options.join(', ')})`);
+  check(await cpage.evaluate(() => window.rccxView.plotted) === names[0], 'the first robot\'s plots are shown first');
+  // Both robots' plots fill, the hidden one's too.
+  await cpage.waitForFunction((ns) => ns.every((n) => (window.rccxView.plots[n]?.joints ?? 0) > 30),
+    names, { timeout: 30000 });
+  await cpage.selectOption('#plot-robot', { label: names[1] });
+  await cpage.waitForTimeout(400);
+  const shownGroups = await cpage.$$eval('.plot-group', (gs) => gs.filter((g) => !g.hidden).map((g) => g.dataset.robot));
+  check(await cpage.evaluate(() => window.rccxView.plotted) === names[1] && shownGroups.join() === names[1],
+    `choosing ${names[1]} shows its plots alone (${shownGroups.join(', ')})`);
+  const shownPoints = await cpage.evaluate(() => window.rccxView.plotPoints);
+  check(shownPoints.joints > 30 && shownPoints.cart > 30 && shownPoints.vel > 30,
+    `${names[1]}'s plots fill (${shownPoints.joints} / ${shownPoints.cart} / ${shownPoints.vel} points)`);
+  // Each robot's joint plot holds that robot's samples: its last point is the server's sample of
+  // that robot at that time, in as many joints as it has.
+  for (const [i, name] of [[1, names[1]], [0, names[0]]]) {
+    const last = await cpage.evaluate((n) => window.rccxView.plotData(n), name);
+    const at = await (await fetch(`${cell.url}api/state?robot=${name}&t=${last.t}`)).json();
+    const dof = cscene.robots[i].joints.length;
+    const diff = at.qm ? Math.max(...at.qm.map((q, k) => Math.abs(q - last.qm[k]))) : Infinity;
+    check(last.qm.length === dof && diff < 1e-9 && last.title.startsWith(`${name}:`),
+      `${name}'s joint plot holds its own samples (${last.qm.length} joints at t ${last.t.toFixed(3)} s, ` +
+      `within ${diff.toExponential(1)} of the server's; "${last.title}")`);
+  }
+  // The goals of both robots' moves, drawn though rccx view never calls show(); the running ones marked.
+  await cpage.waitForFunction((ns) => ns.every((n, i) => window.rccxView.frameNames.includes(`${i}:${n}_P1`)),
+    names, { timeout: 30000 });
+  await cpage.waitForFunction(() => window.rccxView.robots.every((r) => r.goal), null, { timeout: 30000 });
+  const marks = await cpage.evaluate(() => ({
+    goals: window.rccxView.robots.map((r) => r.goal),
+    active: [...document.querySelectorAll('.label.active')].map((e) => e.textContent),
+  }));
+  check(marks.goals.every((g, i) => g.startsWith(`${names[i]}_P`)) && marks.active.length >= 1,
+    `each robot's running goal is marked (${marks.goals.join(', ')}; marked: ${marks.active.join(', ')})`);
+  await cpage.screenshot({ path: join(artifacts, 'view-cell.png') });
+  check(cerrors.length === 0, `no console error on the cell's page (${cerrors.join('; ') || 'none'})`);
+  await stop(cell.proc);
 } catch (e) {
   console.log(`FAIL ${e.stack || e}`);
   failures++;

@@ -17,12 +17,18 @@
 #include <nlohmann/json.hpp>
 #include <thread>
 
+#include "rccx/cell/cell.hpp"
+#include "rccx/kinematics/kinematics.hpp"
 #include "rccx/rccl/manipulator.hpp"
 #include "rccx/rtc/simulated_robot.hpp"
 #include "rccx/view/plot.hpp"
 #include "rccx/view/run_log.hpp"
 #include "rccx/view/server.hpp"
 #include "shell_run.hpp"
+
+#ifdef RCCX_HAVE_RSVG
+#include <cairo.h>
+#endif
 
 namespace {
 
@@ -229,6 +235,117 @@ TEST(ViewServer, DetachesFromTheSessionWhileItRuns) {
   }
 }
 
+/// The frame of `scene` named `name`, or null.
+const json* frame_named(const json& scene, const std::string& name) {
+  for (const json& f : scene["frames"]) {
+    if (f["name"] == name) return &f;
+  }
+  return nullptr;
+}
+
+/// The position part of a transform as the page takes it (column-major 4 x 4).
+math::Vec3 position_of(const json& pose) {
+  return {pose[12].get<double>(), pose[13].get<double>(), pose[14].get<double>()};
+}
+
+TEST(ViewServer, ShowsTheGoalOfEachMoveOfAnAttachedArmWithoutShow) {
+  rtc::SimulatedRobot robot(kin::builtin_robot("puma560"));
+  rccl::Manipulator arm(*robot.session);
+  auto server = view::serve(arm, 0, quiet());
+  const std::uint16_t port = server->port();
+  arm.start();
+  arm.set_velocity(0.05, 0.3);  // slow enough that each motion is seen running
+  const auto kinematics = kin::make_kinematics(robot.model);
+  kin::JointVector qa = robot.model.ready();
+  qa[0] += 0.3;
+  kin::JointVector qb = qa;
+  qb[0] -= 0.3;
+  qb[4] += 0.2;
+  const math::Transform tb = kinematics->forward(qb);
+  const auto t6 = rccl::t6();
+  const auto a = rccl::Position::joints("A", qa);
+  const auto b = rccl::Position::make("B", {t6}, {rccl::constant("GB", tb)}, t6);
+  EXPECT_TRUE(json::parse(request(port, "/api/scene").body)["frames"].empty());
+
+  const rccl::Motion ma = arm.move(a);
+  const rccl::Motion mb = arm.move(b);
+  json scene = json::parse(request(port, "/api/scene").body);
+  EXPECT_EQ(scene["frames"].size(), 2U) << scene["frames"].dump();
+  const json* fa = frame_named(scene, "A");
+  const json* fb = frame_named(scene, "B");
+  ASSERT_TRUE(fa != nullptr && fb != nullptr) << scene["frames"].dump();
+  EXPECT_EQ((*fa)["robot"], 0);
+  EXPECT_LT((position_of((*fa)["pose"]) - kinematics->forward(qa).p).norm(), 1e-9);
+  EXPECT_LT((position_of((*fb)["pose"]) - tb.p).norm(), 1e-9);
+  EXPECT_NE((*fb)["note"].get<std::string>().find("GB"), std::string::npos) << (*fb)["note"];
+
+  // The samples of each motion name the goal it goes to.
+  const auto goal_now = [&] {
+    std::this_thread::sleep_for(150ms);  // the server thread drains every 20 ms
+    const json latest = json::parse(request(port, "/api/state").body)["robots"][0];
+    return latest.value("goal", std::string("(none)"));
+  };
+  ASSERT_EQ(arm.waitfor(ma.start()), rccl::WaitResult::reached);
+  robot.session->wait_for(100ms);
+  ASSERT_FALSE(arm.happened(ma.end()));
+  EXPECT_EQ(goal_now(), "A");
+  ASSERT_EQ(arm.waitfor(mb.start()), rccl::WaitResult::reached);
+  robot.session->wait_for(100ms);
+  ASSERT_FALSE(arm.happened(mb.end()));
+  EXPECT_EQ(goal_now(), "B");
+  ASSERT_EQ(arm.waitfor(rccl::Manipulator::completed()), rccl::WaitResult::reached);
+
+  // The same position again is the same frame; a refused move shows nothing.
+  arm.move(a);
+  kin::JointVector far = qa;
+  far[0] = robot.model.joints[0].upper + 1.0;
+  EXPECT_THROW(arm.move(rccl::Position::joints("OUT", far)), rccl::MotionError);
+  scene = json::parse(request(port, "/api/scene").body);
+  EXPECT_EQ(scene["frames"].size(), 2U) << scene["frames"].dump();
+  EXPECT_EQ(frame_named(scene, "OUT"), nullptr);
+
+  // The arm may outlive the view: its observer then does nothing.
+  server.reset();
+  const rccl::Motion again = arm.move(b);
+  EXPECT_EQ(arm.waitfor(again.end()), rccl::WaitResult::reached);
+}
+
+TEST(ViewServer, ACellShowsEachRobotsGoalsWithoutShow) {
+  const auto c = cell::Cell::load(RCCX_CVARL_CELL);
+  c->start();
+  auto server = view::serve(*c, 0, quiet());
+  const std::uint16_t port = server->port();
+  std::vector<rccl::Motion> motions;
+  std::vector<math::Vec3> goals;
+  for (const char* name : {"puma", "microbo"}) {
+    rccl::Manipulator& arm = c->robot(name);
+    arm.set_velocity(0.05, 0.3);
+    kin::JointVector q = arm.kinematics().model().ready();
+    q[3] += 0.3;  // a wrist: the arms keep apart
+    motions.push_back(arm.move(rccl::Position::joints(fmt::format("{}_GOAL", name), q)));
+    goals.push_back((c->base(name) * arm.kinematics().forward(q)).p);
+  }
+  c->wait_for(100ms);
+  std::this_thread::sleep_for(150ms);
+  const json scene = json::parse(request(port, "/api/scene").body);
+  const json state = json::parse(request(port, "/api/state").body);
+  const char* names[] = {"puma", "microbo"};
+  for (int r = 0; r < 2; ++r) {
+    const std::string goal = fmt::format("{}_GOAL", names[r]);
+    const json* f = frame_named(scene, goal);
+    ASSERT_NE(f, nullptr) << scene["frames"].dump();
+    EXPECT_EQ((*f)["robot"], r);
+    EXPECT_LT((position_of((*f)["pose"]) - goals[static_cast<std::size_t>(r)]).norm(), 1e-9);
+    ASSERT_FALSE(c->robot(names[r]).happened(motions[static_cast<std::size_t>(r)].end()));
+    EXPECT_EQ(state["robots"][r].value("goal", std::string("(none)")), goal);
+  }
+  // One robot's page lists its own goals, not the other's.
+  const json microbo = json::parse(request(port, "/api/scene?robot=microbo").body);
+  EXPECT_NE(frame_named(microbo, "microbo_GOAL"), nullptr);
+  EXPECT_EQ(frame_named(microbo, "puma_GOAL"), nullptr);
+  server.reset();  // before the cell's sessions
+}
+
 constexpr const char* kGoodLog =
     "t,seg,q1,q2,qm1,qm2,x,y,z,ax,ay,az\n"
     "0.01,0,0.1,0.2,0.1,0.2,0.5,0,0.3,0,0,-1\n"
@@ -285,21 +402,23 @@ TEST(RunLog, ReplayRefusesALogOfAnotherRobot) {
                view::RunLogError);
 }
 
+/// A recorded run of the PUMA (RCCX_LOG's format, through SampleLog itself) in `file`.
+void record_puma_run(const std::filesystem::path& file) {
+  rtc::SimulatedRobotOptions options;
+  options.log = file;
+  rtc::SimulatedRobot robot(kin::builtin_robot("puma560"), options);
+  rccl::Manipulator arm(*robot.session);
+  arm.start();
+  kin::JointVector q = robot.model.ready();
+  q[0] += 0.3;
+  arm.waitfor(arm.move(rccl::Position::joints("A", q)).end());
+  arm.stop_control();
+  EXPECT_EQ(robot.finish(), "");
+}
+
 TEST(Plot, DrawsTheFourPanels) {
-  // A recorded run of the PUMA (RCCX_LOG's format, through SampleLog itself).
   const auto file = std::filesystem::temp_directory_path() / "rccx_view_test_run.csv";
-  {
-    rtc::SimulatedRobotOptions options;
-    options.log = file;
-    rtc::SimulatedRobot robot(kin::builtin_robot("puma560"), options);
-    rccl::Manipulator arm(*robot.session);
-    arm.start();
-    kin::JointVector q = robot.model.ready();
-    q[0] += 0.3;
-    arm.waitfor(arm.move(rccl::Position::joints("A", q)).end());
-    arm.stop_control();
-    EXPECT_EQ(robot.finish(), "");
-  }
+  record_puma_run(file);
   const view::RunLog log = view::load_run_log(file);
   const std::string svg = view::plot_svg(log, kin::builtin_robot("puma560"), "a <test> run");
   EXPECT_EQ(svg.rfind("<svg", 0), 0U);
@@ -328,14 +447,69 @@ TEST(ViewCli, BadInputExitsTwoWithWhatToDo) {
   EXPECT_NE(r.out.find("--log: "), std::string::npos) << r.out;
 
   std::ofstream(dir / "good.csv") << kGoodLog;
-  r = test::rccx_run(fmt::format("plot {}/good.csv -o {}/out.png", dir.string(), dir.string()));
+  r = test::rccx_run(fmt::format("plot {}/good.csv -o {}/out.pdf", dir.string(), dir.string()));
   EXPECT_EQ(r.exit_code, 2);
-  EXPECT_NE(r.out.find("name the file *.svg"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("out.pdf: rccx plot writes SVG or PNG; name the file *.svg or *.png"),
+            std::string::npos)
+      << r.out;
+  EXPECT_FALSE(std::filesystem::exists(dir / "out.pdf"));
 
   view::Server taken(view::Scene::of_robot(kin::builtin_robot("microbo")), 0, quiet());
   r = test::rccx_run(fmt::format("view --robot microbo --port {} --seconds 1", taken.port()));
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.out.find("is in use"), std::string::npos) << r.out;
+  std::filesystem::remove_all(dir);
+}
+
+/// Big-endian 32 bits at `at` of `s`.
+std::uint32_t be32(const std::string& s, std::size_t at) {
+  std::uint32_t v = 0;
+  for (std::size_t i = 0; i < 4; ++i) v = (v << 8) | static_cast<unsigned char>(s.at(at + i));
+  return v;
+}
+
+TEST(ViewCli, PlotWritesPng) {
+  const auto dir = std::filesystem::temp_directory_path() / "rccx_view_cli_png_test";
+  std::filesystem::create_directories(dir);
+  const auto run = dir / "run.csv";
+  record_puma_run(run);
+  const auto png = dir / "out.png";
+  const auto r =
+      test::rccx_run(fmt::format("plot {} --robot puma560 -o {}", run.string(), png.string()));
+#ifdef RCCX_HAVE_RSVG
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  std::ifstream in(png, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ASSERT_GE(bytes.size(), 33U);
+  EXPECT_EQ(bytes.substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8));
+  EXPECT_EQ(bytes.substr(12, 4), "IHDR");  // the first chunk: width, height
+  EXPECT_EQ(be32(bytes, 16), 1200U);
+  EXPECT_EQ(be32(bytes, 20), 900U);
+  // Decoded, it is a plot: most pixels the white background, some the lines and text.
+  cairo_surface_t* image = cairo_image_surface_create_from_png(png.c_str());
+  ASSERT_EQ(cairo_surface_status(image), CAIRO_STATUS_SUCCESS);
+  // Opaque: cairo writes it as RGB and reads it back as RGB24 (the top byte unused).
+  const cairo_format_t format = cairo_image_surface_get_format(image);
+  ASSERT_TRUE(format == CAIRO_FORMAT_RGB24 || format == CAIRO_FORMAT_ARGB32) << format;
+  const int w = cairo_image_surface_get_width(image), h = cairo_image_surface_get_height(image);
+  const int stride = cairo_image_surface_get_stride(image);
+  const unsigned char* data = cairo_image_surface_get_data(image);
+  std::size_t white = 0, other = 0;
+  for (int y = 0; y < h; ++y) {
+    const auto* row =
+        reinterpret_cast<const std::uint32_t*>(data + static_cast<std::ptrdiff_t>(y) * stride);
+    for (int x = 0; x < w; ++x) ((row[x] & 0xffffffU) == 0xffffffU ? white : other)++;
+  }
+  cairo_surface_destroy(image);
+  const double total = static_cast<double>(w) * h;
+  EXPECT_GT(static_cast<double>(white) / total, 0.5) << "the background is white";
+  EXPECT_GT(static_cast<double>(other) / total, 0.01) << "lines and text are drawn";
+#else
+  // Built without librsvg: -o FILE.png says how to get it, and writes nothing.
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.out.find("install librsvg2-dev"), std::string::npos) << r.out;
+  EXPECT_FALSE(std::filesystem::exists(png));
+#endif
   std::filesystem::remove_all(dir);
 }
 

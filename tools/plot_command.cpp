@@ -2,11 +2,15 @@
 
 #include <fmt/format.h>
 
+#include <cctype>
 #include <filesystem>
 #include <memory>
 #include <string>
 
 #include "rccx/io/file.hpp"
+#ifdef RCCX_HAVE_RSVG
+#include "plot_png.hpp"
+#endif
 #include "rccx/view/plot.hpp"
 #include "rccx/view/run_log.hpp"
 
@@ -24,10 +28,22 @@ struct PlotArgs {
 int run_plot(const PlotArgs& a) {
   const kin::RobotModel model = a.robot.model();
   const std::filesystem::path out(a.out);
-  const std::string ext = out.extension().string();
-  if (ext != ".svg") {
-    throw BadArgument{fmt::format("-o {}: rccx plot writes SVG; name the file *.svg", a.out)};
+  std::string ext = out.extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  // The format is the file name's: refused before the log is read, so nothing is half done.
+  if (ext != ".svg" && ext != ".png") {
+    throw BadArgument{
+        fmt::format("-o {}: rccx plot writes SVG or PNG; name the file *.svg or *.png", a.out)};
   }
+#ifndef RCCX_HAVE_RSVG
+  if (ext == ".png") {
+    throw BadArgument{fmt::format(
+        "-o {}: this rccx was built without PNG output (librsvg was not found when it was "
+        "configured): install librsvg2-dev (scripts/install-deps does) and configure the build "
+        "again, or write SVG (-o FILE.svg)",
+        a.out)};
+  }
+#endif
   view::RunLog log;
   std::string svg;
   try {
@@ -38,7 +54,11 @@ int run_plot(const PlotArgs& a) {
     throw BadArgument{e.what()};
   }
   io::AtomicFile file(out);
+#ifdef RCCX_HAVE_RSVG
+  file.write(ext == ".png" ? svg_to_png(svg) : svg);
+#else
   file.write(svg);
+#endif
   file.commit();
   fmt::print("{}: {} samples, {:.2f} s -> {}\n", a.log, log.rows.size(),
              log.rows.back().t_s - log.rows.front().t_s, a.out);
@@ -51,13 +71,14 @@ void add_plot_command(CLI::App& app, int& exit_code) {
   auto args = std::make_shared<PlotArgs>();
   CLI::App* cmd = app.add_subcommand(
       "plot",
-      "Plot a recorded run (a CSV written by --log or RCCX_LOG) as an SVG, without a browser: "
-      "the joints, the tool path in the plane it moves in most, the speed along the path and "
-      "the path error (the measured tool from the commanded path).");
+      "Plot a recorded run (a CSV written by --log or RCCX_LOG) as an SVG or a PNG (the file "
+      "name's extension says which; 1200 x 900 px), without a browser: the joints, the tool "
+      "path in the plane it moves in most, the speed along the path and the path error (the "
+      "measured tool from the commanded path).");
   cmd->add_option("log", args->log, "The run: a CSV rccx wrote (--log FILE, RCCX_LOG=FILE)")
       ->required()
       ->check(CLI::ExistingFile);
-  cmd->add_option("-o,--output", args->out, "The SVG to write (replaced whole)")
+  cmd->add_option("-o,--output", args->out, "The file to write, *.svg or *.png (replaced whole)")
       ->required()
       ->check(not_empty());
   add_robot_options(*cmd, args->robot);

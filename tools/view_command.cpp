@@ -102,15 +102,14 @@ int run_robot(const ViewArgs& a) {
   // Simulated time (deterministic, and no overrun on a busy machine), paced to the wall clock.
   rtc::SimulatedRobot robot(model);
   rccl::Manipulator arm(*robot.session);
-  const auto server =
-      view::serve(*robot.session, static_cast<std::uint16_t>(a.port), serve_options(a));
+  // The arm's, so that the page draws the goal of each move (and marks the running one).
+  const auto server = view::serve(arm, static_cast<std::uint16_t>(a.port), serve_options(a));
   arm.start();
   arm.set_velocity(0.1, 0.6);
   const auto goals = sweep(model);
   std::vector<rccl::PositionPtr> positions;
   for (std::size_t i = 0; i < goals.size(); ++i) {
     positions.push_back(rccl::Position::joints(fmt::format("P{}", i + 1), goals[i]));
-    server->show(positions.back());
   }
   const Deadline deadline(a.seconds);
   int code = kOk;

@@ -1,9 +1,13 @@
 // The page `rccx view` serves: the robots in 3D (three.js), drawn from their DH chains, with the
-// tool path traced, named frames, the cell's objects and capsules; live joint, Cartesian and
-// velocity plots (uPlot); and, for a recorded run, a replay with a time slider.
+// tool path traced, named frames (the cell's, and the goals of the positions the program moves
+// to, the running motion's marked), the cell's objects and capsules; live joint, Cartesian and
+// velocity plots (uPlot) of each robot, one robot's at a time (the selector above them); and, for
+// a recorded run (one robot's), a replay with a time slider.
 //
 // What the page draws is also in window.rccxView (for the end-to-end test): the joint values
-// and time of the pose drawn, per robot, and how many points each plot holds.
+// and time of the pose drawn, per robot, the goal each robot's running motion goes to, the
+// frames drawn, which robot's plots are shown, how many points they hold, and plotData(name):
+// the last point of a robot's joint plot as uPlot holds it, back in rad / m.
 import * as THREE from 'three';
 import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
 import { CSS2DRenderer, CSS2DObject } from 'three/examples/jsm/renderers/CSS2DRenderer.js';
@@ -17,7 +21,11 @@ const view = {
   errors: [],
   frames: 0,
   robots: [],
-  plotPoints: { joints: 0, cart: 0, vel: 0 },
+  plotPoints: { joints: 0, cart: 0, vel: 0 },  // the plots shown
+  plotted: null,       // the name of the robot whose plots are shown
+  plots: {},           // per robot name: its points { joints, cart, vel }
+  frameNames: [],      // the frames drawn, "name" (the cell's) or "robot:name" (a goal)
+  plotData: () => null,
 };
 window.rccxView = view;
 
@@ -110,6 +118,8 @@ const colours = [0xe0a040, 0x50a0e0, 0x80d080, 0xd070d0];
 class RobotView {
   constructor(desc, index) {
     this.name = desc.name;
+    this.index = desc.index;
+    this.goal = null;
     this.joints = desc.joints;
     this.baseMatrix = new THREE.Matrix4().fromArray(desc.base);
     this.toolMatrix = desc.tool ? new THREE.Matrix4().fromArray(desc.tool) : new THREE.Matrix4();
@@ -179,7 +189,7 @@ class RobotView {
     this.path = new THREE.Line(pg, new THREE.LineBasicMaterial({ color: 0xffff66 }));
     this.path.frustumCulled = false;
     scene.add(this.path);
-    this.state = { name: desc.name, t: null, q: desc.joints.map((j) => j.ready), seg: 0 };
+    this.state = { name: desc.name, t: null, q: desc.joints.map((j) => j.ready), seg: 0, goal: null };
     view.robots.push(this.state);
     this.pose(this.state.q);
   }
@@ -242,18 +252,53 @@ function addObject(o) {
   scene.add(l);
 }
 
+// A goal is its robot's: two robots may each have a "P1".
 const frameObjects = new Map();
-function addFrame(f) {
-  if (frameObjects.has(f.name)) return;
-  const axes = new THREE.AxesHelper(0.06);
-  axes.matrixAutoUpdate = false;
-  axes.matrix.fromArray(f.pose);
-  scene.add(axes);
-  const l = label(f.name);
-  l.position.setFromMatrixPosition(axes.matrix);
-  l.element.title = f.note || f.name;
-  scene.add(l);
-  frameObjects.set(f.name, axes);
+const activeGoals = new Set();  // the keys of the goals running motions go to
+const frameKey = (robot, name) => (robot >= 0 ? `${robot}:${name}` : name);
+/// Puts a frame at its pose, drawn larger and its label marked while a motion goes there.
+function placeFrame(key, entry) {
+  const on = activeGoals.has(key);
+  const k = on ? 2 : 1;
+  entry.axes.matrix.fromArray(entry.pose).multiply(new THREE.Matrix4().makeScale(k, k, k));
+  entry.label.position.setFromMatrixPosition(entry.axes.matrix);
+  entry.label.element.classList.toggle('active', on);
+}
+function addFrame(f, robotNames) {
+  const key = frameKey(f.robot ?? -1, f.name);
+  let entry = frameObjects.get(key);
+  if (!entry) {
+    const axes = new THREE.AxesHelper(0.06);
+    axes.matrixAutoUpdate = false;
+    scene.add(axes);
+    const text = f.robot >= 0 && robotNames[f.robot] ? `${robotNames[f.robot]}: ${f.name}` : f.name;
+    const l = label(text);
+    scene.add(l);
+    entry = { axes, label: l, pose: null };
+    frameObjects.set(key, entry);
+    view.frameNames.push(key);
+  }
+  // A goal moved to again with other values of its transforms moves its frame.
+  if (entry.pose === null || entry.pose.some((v, i) => v !== f.pose[i])) {
+    entry.pose = f.pose.slice();
+    placeFrame(key, entry);
+  }
+  entry.label.element.title = f.note || f.name;
+}
+/// Marks the goal robot `r`'s running motion goes to, and unmarks its last one.
+function markGoal(r, goal) {
+  goal = goal || null;
+  if (r.goal === goal) return;
+  const before = r.goal ? frameKey(r.index, r.goal) : null;
+  const now = goal ? frameKey(r.index, goal) : null;
+  if (before) activeGoals.delete(before);
+  if (now) activeGoals.add(now);
+  for (const key of [before, now]) {
+    const entry = key ? frameObjects.get(key) : null;
+    if (entry) placeFrame(key, entry);
+  }
+  r.goal = goal;
+  r.state.goal = goal;
 }
 
 // --- Plots ------------------------------------------------------------------------------------
@@ -273,14 +318,28 @@ function makePlot(el, title, names, unit) {
   }, [[], ...names.map(() => [])], el);
 }
 
+/// One robot's three plots, in their own group of the aside; only the group shown is drawn.
 class Plots {
   constructor(robot, desc) {
     this.robot = robot;
+    this.name = desc.name;
     this.units = desc.joints.map((j) => (j.prismatic ? 1000 : 180 / Math.PI));
     const names = desc.joints.map((j, i) => `q${i + 1} ${j.prismatic ? 'mm' : 'deg'}`);
-    this.joints = makePlot($('plot-joints'), `${desc.name}: joints (measured)`, names, 'deg / mm');
-    this.cart = makePlot($('plot-cart'), `${desc.name}: tool position (world)`, ['x', 'y', 'z'], 'mm');
-    this.vel = makePlot($('plot-vel'), `${desc.name}: speeds`,
+    this.group = document.createElement('div');
+    this.group.className = 'plot-group';
+    this.group.dataset.robot = desc.name;
+    this.group.hidden = true;
+    const div = (kind) => {
+      const d = document.createElement('div');
+      d.className = `plot plot-${kind}`;
+      this.group.appendChild(d);
+      return d;
+    };
+    $('plot-groups').appendChild(this.group);
+    this.shown = false;
+    this.joints = makePlot(div('joints'), `${desc.name}: joints (measured)`, names, 'deg / mm');
+    this.cart = makePlot(div('cart'), `${desc.name}: tool position (world)`, ['x', 'y', 'z'], 'mm');
+    this.vel = makePlot(div('vel'), `${desc.name}: speeds`,
       desc.joints.map((j, i) => `qd${i + 1} ${j.prismatic ? 'mm/s' : 'deg/s'}`).concat(['tool mm/s']),
       'deg/s, mm/s');
     this.limit = 3000;
@@ -324,15 +383,34 @@ class Plots {
     d.vel = [log.t, ...qd, speed];
     this.dirty = true;
   }
+  points() {
+    return { joints: this.data.joints[0].length, cart: this.data.cart[0].length, vel: this.data.vel[0].length };
+  }
+  /// Draws what came since the last flush; a hidden group only counts (drawn when shown).
   flush() {
-    if (!this.dirty) return;
+    view.plots[this.name] = this.points();
+    if (!this.dirty || !this.shown) return;
     this.dirty = false;
     this.joints.setData(this.data.joints);
     this.cart.setData(this.data.cart);
     this.vel.setData(this.data.vel);
-    view.plotPoints = {
-      joints: this.data.joints[0].length, cart: this.data.cart[0].length, vel: this.data.vel[0].length,
-    };
+    view.plotPoints = this.points();
+  }
+  show(on) {
+    this.shown = on;
+    this.group.hidden = !on;
+    if (on) {
+      this.dirty = true;
+      this.resize();
+      this.flush();
+    }
+  }
+  /// The last point of the joint plot as drawn, in rad / m.
+  last() {
+    const d = this.joints.data;
+    const n = d[0].length;
+    if (n === 0) return null;
+    return { t: d[0][n - 1], qm: this.units.map((u, i) => d[i + 1][n - 1] / u), title: this.joints.root.querySelector('.u-title')?.textContent };
   }
   resize() {
     for (const p of [this.joints, this.cart, this.vel]) p.setSize({ width: plotWidth(), height: 170 });
@@ -363,8 +441,11 @@ async function main() {
   }
   const robots = new Map();
   desc.robots.forEach((r, i) => robots.set(r.index, new RobotView(r, i)));
+  // A goal's label names its robot when the page shows several.
+  const robotNames = [];
+  if (desc.robots.length > 1) for (const r of desc.robots) robotNames[r.index] = r.name;
   desc.objects.forEach(addObject);
-  desc.frames.forEach(addFrame);
+  desc.frames.forEach((f) => addFrame(f, robotNames));
   // The camera takes in every robot at its ready pose and the objects.
   const box = new THREE.Box3();
   for (const r of robots.values()) {
@@ -379,21 +460,46 @@ async function main() {
     controls.update();
   }
   const first = desc.robots[0];
-  const plots = new Plots(robots.get(first.index), first);
+  // Every robot's plots fill as its samples come; the selector chooses the ones shown.
+  const plots = new Map();
+  for (const r of desc.robots) plots.set(r.index, new Plots(robots.get(r.index), r));
+  let shown = plots.get(first.index);
+  const select = $('plot-robot');
+  const choose = (index) => {
+    shown.show(false);
+    shown = plots.get(index);
+    shown.show(true);
+    view.plotted = shown.name;
+    view.plotPoints = shown.points();
+    readout(shown.robot, desc.robots.find((r) => r.index === index), shown.robot.state.t);
+  };
+  if (desc.robots.length > 1 && desc.mode !== 'replay') {
+    select.innerHTML = desc.robots.map((r) => `<option value="${r.index}">${r.name}</option>`).join('');
+    select.hidden = false;
+    select.addEventListener('change', () => choose(Number(select.value)));
+  }
+  shown.show(true);
+  view.plotted = shown.name;
+  view.plotData = (name) => {
+    for (const p of plots.values()) if (p.name === name) return p.last();
+    return null;
+  };
   resize();
-  window.addEventListener('resize', () => plots.resize());
+  window.addEventListener('resize', () => shown.resize());
 
-  // Frames the program adds while it runs (position equations shown later).
-  setInterval(async () => {
+  // Frames the program adds while it runs (the goals of the positions it moves to).
+  const refreshFrames = async () => {
     try {
       const s = await (await fetch(only ? `/api/scene?robot=${encodeURIComponent(only)}` : '/api/scene')).json();
-      s.frames.forEach(addFrame);
+      s.frames.forEach((f) => addFrame(f, robotNames));
     } catch { /* the program ended: the status line says so */ }
-  }, 2000);
+  };
+  setInterval(refreshFrames, 2000);
 
   let latest = null;
+  let refreshing = false;
   if (desc.mode === 'replay') {
-    await replay(robots.get(first.index), first, plots);
+    await replay(robots.get(first.index), first, shown);
   } else {
     const ws = new WebSocket(`ws://${location.host}/ws${only ? `?robot=${encodeURIComponent(only)}` : ''}`);
     ws.onopen = () => status('live');
@@ -411,7 +517,13 @@ async function main() {
         r.state.q = f.q.slice();
         r.state.seg = f.seg;
         r.addPathPoint(f.p);
-        if (f.r === first.index) plots.push(f);
+        plots.get(f.r).push(f);
+        // A goal not drawn yet (moved to since the last look at the scene): look again soon.
+        if (f.goal && !frameObjects.has(frameKey(f.r, f.goal)) && !refreshing) {
+          refreshing = true;
+          refreshFrames().finally(() => { refreshing = false; });
+        }
+        markGoal(r, f.goal);
         view.frames++;
         latest = f;
       }
@@ -429,8 +541,9 @@ async function main() {
       }
     }
     if (desc.mode !== 'replay') {
-      plots.flush();
-      readout(robots.get(first.index), first, latest ? robots.get(first.index).state.t : null);
+      for (const p of plots.values()) p.flush();
+      const d = desc.robots.find((r) => r.index === shown.robot.index);
+      readout(shown.robot, d, latest ? shown.robot.state.t : null);
     }
     controls.update();
     renderer.render(scene, camera);

@@ -319,6 +319,7 @@ Motion Manipulator::move(const PositionPtr& position, const StartWhen& when) {
     }
   }();
   settings_.tool = saved_tool;
+  if (move_observer_) move_observer_(m, position);
   return m;
 }
 

@@ -17,6 +17,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <set>
@@ -126,6 +127,12 @@ class Manipulator {
   /// (the motion before it comes to rest first unless its gates are open by then) and is cancelled
   /// with the reason when a gate cannot open.
   Motion move(const PositionPtr& position, const StartWhen& when = {});
+  /// Called by each move() that queued a motion (after it did; not by dwell), with the motion
+  /// and its position, on the thread that called move() - never from the sample loop. What
+  /// rccx::view::Server::attach shows the goals of the running equations with. One observer: a
+  /// new one replaces the last, {} removes it. Must not throw (the motion is queued already).
+  using MoveObserver = std::function<void(const Motion&, const PositionPtr&)>;
+  void set_move_observer(MoveObserver observer) { move_observer_ = std::move(observer); }
   /// RCCL's stop(): stay where the previous motion ends for `seconds` (gated as move()).
   Motion dwell(double seconds, const StartWhen& when = {});
   /// Stops smoothly where the arm is and cancels everything queued.
@@ -194,6 +201,7 @@ class Manipulator {
   MotionSettings settings_;
   PositionPtr park_;
   std::vector<PositionPtr> keep_;  ///< positions the loop may still point to
+  MoveObserver move_observer_;     ///< planning side only
   std::vector<std::shared_ptr<Rendezvous>> keep_rendezvous_;  ///< likewise
   std::uint64_t next_id_ = 1;
   bool started_ = false;

@@ -77,7 +77,9 @@ nlohmann::json to_json(const Scene& scene, int only) {
   }
   nlohmann::json frames = nlohmann::json::array();
   for (const SceneFrame& f : scene.frames) {
-    frames.push_back({{"name", f.name}, {"pose", to_json(f.pose)}, {"note", f.note}});
+    if (only >= 0 && f.robot >= 0 && f.robot != only) continue;
+    frames.push_back(
+        {{"name", f.name}, {"pose", to_json(f.pose)}, {"note", f.note}, {"robot", f.robot}});
   }
   return {{"title", scene.title}, {"robots", robots}, {"objects", objects}, {"frames", frames}};
 }

@@ -28,6 +28,7 @@ struct SceneFrame {
   std::string name;
   math::Transform pose;  ///< world <- frame
   std::string note;
+  int robot = -1;  ///< the scene robot whose equation's goal this is; -1: the cell's, or none
 };
 
 struct Scene {
@@ -45,7 +46,7 @@ struct Scene {
 
 /// A transform as the page takes it: 16 numbers, column-major (three.js Matrix4.fromArray).
 nlohmann::json to_json(const math::Transform& t);
-/// The scene as the page reads it; `only` >= 0: that robot alone.
+/// The scene as the page reads it; `only` >= 0: that robot alone (and no other robot's goals).
 nlohmann::json to_json(const Scene& scene, int only = -1);
 
 }  // namespace rccx::view

@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <boost/asio.hpp>
@@ -18,6 +19,7 @@
 #include <deque>
 #include <future>
 #include <limits>
+#include <map>
 #include <mutex>
 #include <nlohmann/json.hpp>
 #include <set>
@@ -28,6 +30,7 @@
 #include "rccx/io/console.hpp"
 #include "rccx/io/file.hpp"
 #include "rccx/kinematics/kinematics.hpp"
+#include "rccx/rccl/manipulator.hpp"
 #include "rccx/rtc/session.hpp"
 
 #ifndef RCCX_VIEW_BUILD_ASSETS
@@ -107,6 +110,57 @@ class RobotTap final : public rtc::SampleTap {
   double last_t_s_ = -std::numeric_limits<double>::infinity();
   boost::lockfree::spsc_queue<TapSample, boost::lockfree::capacity<1024>> queue_;
   std::atomic<std::uint64_t> dropped_{0};
+};
+
+/// The frames the program adds (add_frame, show, the goals of attached arms' moves) and which
+/// goal each queued motion goes to. Written at the planning level, read by the server thread.
+/// The arms' move observers hold it weakly: an arm that outlives the server finds it gone.
+struct Goals {
+  std::mutex mutex;
+  std::vector<SceneFrame> frames;
+  /// Per scene robot: motion id -> index in frames, for the motions not yet past.
+  std::vector<std::map<std::uint64_t, std::size_t>> motion_frame;
+  /// Per scene robot, fixed before any thread shares this (the solvers keep no state).
+  std::vector<std::unique_ptr<kin::Kinematics>> kinematics;
+  std::vector<math::Transform> base;
+
+  /// The world pose of `p`'s goal (the tool frame where the equation puts it) for `robot`,
+  /// drawn and named; the same name for the same robot moves its frame. `motion` != 0: the
+  /// motion that goes there.
+  void show(const rccl::Position& p, std::size_t robot, std::uint64_t motion) {
+    math::Transform goal;
+    if (p.in_joints()) {
+      goal = kinematics.at(robot)->forward(p.joint_values());
+    } else if (p.fixed()) {
+      goal = p.t6_now();
+    } else {
+      goal = p.t6_at({});
+    }
+    SceneFrame f{p.name(), base.at(robot) * goal * p.tool_now(), p.describe(),
+                 static_cast<int>(robot)};
+    std::lock_guard lock(mutex);
+    const auto same = std::find_if(frames.begin(), frames.end(), [&](const SceneFrame& g) {
+      return g.robot == f.robot && g.name == f.name;
+    });
+    const std::size_t index = static_cast<std::size_t>(same - frames.begin());
+    if (same == frames.end()) {
+      frames.push_back(std::move(f));
+    } else {
+      *same = std::move(f);
+    }
+    if (motion != 0) motion_frame.at(robot)[motion] = index;
+  }
+
+  /// The name of the goal motion `id` of `robot` goes to, empty when not known; forgets the
+  /// motions before it (a generator runs its motions in the order of their ids). Server thread.
+  std::string goal_of(std::size_t robot, std::uint64_t id) {
+    if (id == 0) return {};
+    std::lock_guard lock(mutex);
+    auto& m = motion_frame[robot];
+    m.erase(m.begin(), m.lower_bound(id));
+    const auto it = m.find(id);
+    return it == m.end() ? std::string() : frames[it->second].name;
+  }
 };
 
 std::string_view content_type(const std::filesystem::path& p) {
@@ -205,8 +259,8 @@ struct Server::Impl {
   std::optional<RunLog> replay;
   json replay_json;
 
-  mutable std::mutex state_mutex;  ///< latest, frames, stats (server thread vs planning level)
-  std::vector<SceneFrame> extra_frames;
+  mutable std::mutex state_mutex;  ///< latest (server thread vs planning level)
+  std::shared_ptr<Goals> goals = std::make_shared<Goals>();
   std::set<WsSession*> pages;  ///< server thread only
   std::atomic<std::uint64_t> samples_sent{0}, messages_dropped{0}, requests{0};
   std::atomic<std::size_t> page_count{0};
@@ -214,8 +268,8 @@ struct Server::Impl {
   json scene_json(int only) const {
     Scene s = scene;
     {
-      std::lock_guard lock(state_mutex);
-      s.frames.insert(s.frames.end(), extra_frames.begin(), extra_frames.end());
+      std::lock_guard lock(goals->mutex);
+      s.frames.insert(s.frames.end(), goals->frames.begin(), goals->frames.end());
     }
     json j = to_json(s, only);
     j["mode"] = replay ? "replay" : "live";
@@ -511,6 +565,11 @@ struct Server::Impl {
                   {"qd", std::vector<double>(s.qd.begin(), s.qd.begin() + s.dof)},
                   {"p", {pose.p.x, pose.p.y, pose.p.z}},
                   {"v", speed}};
+        if (std::string goal =
+                goals->goal_of(r, static_cast<std::uint64_t>(std::max(0, s.segment)));
+            !goal.empty()) {
+          f["goal"] = std::move(goal);
+        }
         rs.history.push_back(f);
         while (rs.history.size() > options.history) rs.history.pop_front();
         per_robot[r].push_back(std::move(f));
@@ -554,6 +613,9 @@ Server::Server(Scene scene, std::uint16_t port, ServeOptions options)
   s.options = std::move(options);
   s.assets = s.options.assets.empty() ? find_assets() : s.options.assets;
   for (const SceneRobot& r : s.scene.robots) {
+    s.goals->kinematics.push_back(kin::make_kinematics(r.model));
+    s.goals->base.push_back(r.base);
+    s.goals->motion_frame.emplace_back();
     Impl::RobotState rs;
     rs.kinematics = kin::make_kinematics(r.model);
     // Every robot's tap is made now, before the server thread runs: attach() only hands it over.
@@ -641,24 +703,35 @@ void Server::set_replay(RunLog log) {
   done.get_future().wait();
 }
 
+void Server::attach(std::size_t robot, rccl::Manipulator& arm) {
+  Impl::RobotState& r = impl_->robots.at(robot);
+  if (r.session == nullptr) {
+    attach(robot, arm.session());
+  } else if (r.session != &arm.session()) {
+    throw ViewError(fmt::format("robot {} of the view taps another session than this arm's",
+                                impl_->scene.robots[robot].name));
+  }
+  arm.set_move_observer([goals = std::weak_ptr<Goals>(impl_->goals), robot](
+                            const rccl::Motion& m, const rccl::PositionPtr& p) {
+    const std::shared_ptr<Goals> g = goals.lock();
+    if (!g || !p) return;
+    try {
+      g->show(*p, robot, m.id);
+    } catch (const std::exception&) {
+      // Only a drawing: a goal that cannot be evaluated now is not drawn, the motion goes on.
+    }
+  });
+}
+
 void Server::show(const rccl::PositionPtr& position, std::size_t robot) {
   if (!position) return;
-  const SceneRobot& r = impl_->scene.robots.at(robot);
-  math::Transform goal;
-  if (position->in_joints()) {
-    goal = kin::make_kinematics(r.model)->forward(position->joint_values());
-  } else if (position->fixed()) {
-    goal = position->t6_now();
-  } else {
-    goal = position->t6_at({});
-  }
-  const math::Transform tool = position->tool_now();
-  add_frame({position->name(), r.base * goal * tool, position->describe()});
+  (void)impl_->scene.robots.at(robot);
+  impl_->goals->show(*position, robot, 0);
 }
 
 void Server::add_frame(SceneFrame frame) {
-  std::lock_guard lock(impl_->state_mutex);
-  impl_->extra_frames.push_back(std::move(frame));
+  std::lock_guard lock(impl_->goals->mutex);
+  impl_->goals->frames.push_back(std::move(frame));
 }
 
 std::uint16_t Server::port() const noexcept {
@@ -691,10 +764,17 @@ std::unique_ptr<Server> serve(rtc::Session& session, std::uint16_t port, ServeOp
   return server;
 }
 
+std::unique_ptr<Server> serve(rccl::Manipulator& arm, std::uint16_t port, ServeOptions options) {
+  auto server = std::make_unique<Server>(Scene::of_robot(arm.session().driver().model()), port,
+                                         std::move(options));
+  server->attach(0, arm);
+  return server;
+}
+
 std::unique_ptr<Server> serve(cell::Cell& cell, std::uint16_t port, ServeOptions options) {
   auto server = std::make_unique<Server>(Scene::of_cell(cell.model()), port, std::move(options));
   for (std::size_t i = 0; i < cell.model().robots.size(); ++i) {
-    server->attach(i, cell.session(cell.model().robots[i].name));
+    server->attach(i, cell.robot(cell.model().robots[i].name));
   }
   return server;
 }

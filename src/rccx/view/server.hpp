@@ -1,7 +1,11 @@
 // `rccx view`: a read-only web page of robots at work, served from the program that drives them.
 //
-//   auto view = rccx::view::serve(*robot.session, 8080);   // prints http://127.0.0.1:8080/
+//   auto view = rccx::view::serve(arm, 8080);   // an rccl::Manipulator; prints
+//   http://127.0.0.1:8080/
 //
+// Served from a Manipulator (or a cell, whose robots are), the page also draws the goal of every
+// position the program moves to, named, as move() queues it, and marks the one the running
+// motion goes to (the motion id travels in the tapped sample as its segment).
 // The sample loop is tapped the way the CSV log is (rtc::Session::set_tap): the communication
 // task copies a fixed-size sample into a lock-free single-producer queue every 1/rate s of
 // sample time (decimated in the loop, so the copy costs nothing the other samples) and returns;
@@ -17,8 +21,9 @@
 //   /                  the page, every robot           /robot/NAME   the page, one robot
 //   /assets/FILE       the bundled front end (web/, built by the project's build)
 //   /api/scene         robots (DH chains, bases, tools, capsules), objects, frames (?robot=NAME)
-//   /api/state         the last sample of every robot; ?robot=NAME&t=T: that robot's at time T
-//   /api/log           replay only: the whole recorded run
+//   /api/state         the last sample of every robot (its "goal": the frame the running
+//                      motion goes to, when known); ?robot=NAME&t=T: that robot's at time T
+//   /api/log           replay only: the whole recorded run (of robot 0: a replay is one robot's)
 //   /ws                the live samples (?robot=NAME), as JSON text messages
 // An unknown robot is a 404 with a message naming the robots there; the server goes on.
 #pragma once
@@ -38,6 +43,9 @@ class Session;
 }
 namespace rccx::cell {
 class Cell;
+}
+namespace rccx::rccl {
+class Manipulator;
 }
 
 namespace rccx::view {
@@ -79,17 +87,25 @@ class Server {
   /// Listens on options.address:port (0: any free port) and starts the server's thread. Throws
   /// ViewError for a port in use or an address that cannot be bound, saying what to do.
   Server(Scene scene, std::uint16_t port, ServeOptions options = {});
-  /// Detaches every tap, then stops the server. Destroy it before the sessions it taps.
+  /// Detaches every tap, then stops the server. Destroy it before the sessions it taps (the
+  /// manipulators it is attached to may outlive it: their observers then do nothing).
   ~Server();
   Server(const Server&) = delete;
   Server& operator=(const Server&) = delete;
 
   /// Taps `session` for scene robot `robot` (0-based). Planning level, any time.
   void attach(std::size_t robot, rtc::Session& session);
+  /// As attach(robot, arm.session()) (unless that session is tapped already), and from now on
+  /// shows the goal of every position `arm` moves to, as show() would, when move() queues it
+  /// (arm's move observer, on the planning thread: nothing is added to the sample loop); the
+  /// samples of that motion name it as their "goal". Replaces any move observer `arm` had.
+  void attach(std::size_t robot, rccl::Manipulator& arm);
   /// Replay: the page gets `log` (robot 0) with a time slider instead of live samples.
   void set_replay(RunLog log);
   /// Draws a position equation's goal (the tool frame where the equation puts it, in the world)
-  /// with its name, for scene robot `robot`. Planning level.
+  /// with its name, for scene robot `robot`; the same name again for the same robot moves that
+  /// frame (a goal whose transforms changed). Planning level. An attached Manipulator's moves
+  /// do this by themselves.
   void show(const rccl::PositionPtr& position, std::size_t robot = 0);
   /// Adds a named frame (world <- frame). Planning level.
   void add_frame(SceneFrame frame);
@@ -107,7 +123,11 @@ class Server {
 /// The view of one robot's session (rtc::SimulatedRobot::session, a Manipulator's session).
 std::unique_ptr<Server> serve(rtc::Session& session, std::uint16_t port = 8080,
                               ServeOptions options = {});
-/// The view of every robot of a cell, with its objects, frames and collision capsules.
+/// The view of one arm: its session, and the goals of the positions it moves to (attach).
+std::unique_ptr<Server> serve(rccl::Manipulator& arm, std::uint16_t port = 8080,
+                              ServeOptions options = {});
+/// The view of every robot of a cell, with its objects, frames and collision capsules, and the
+/// goals of the positions each robot moves to (attach).
 std::unique_ptr<Server> serve(cell::Cell& cell, std::uint16_t port = 8080,
                               ServeOptions options = {});
 /// A recorded run of `model`, replayed in the page. RunLogError when the log's joints do not
