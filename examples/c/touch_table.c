@@ -10,7 +10,7 @@
  *    presses 5 N (POS code RCCL_ONF); getcontact() says where, updatecontact() puts TABLE there.
  * 2. Wipe 150 mm along x, the path planned 5 mm into the table: comply("fz", 5.) lets the tool
  *    yield along its z and press 5 N, so it slides on the surface instead.
- * 3. lock("all"), limit("off"), up and park.
+ * 3. comply("fz", 0.) to lift off, then lock("all") in the air and park.
  * Prints the contact and the wipe's depth; exits 1 when the contact is not within 0.5 mm of
  * the table's top (-203 mm in the file) or the tool went more than 1 mm into the table.
  *
@@ -87,9 +87,12 @@ int main()
   printf("wiped 150 mm planned 5 mm into the table: the tool went %.2f mm into it\n",
          TABLE_TOP - deepest);
 
-  /* 3. Leave. */
-  lock("all");
+  /* 3. Leave: still compliant but asking for no force, so the tool lifts off with the offset
+   * it took (locking now would pull it back to the path, 5 mm into the table); lock in the air. */
+  comply("fz", 0.);
   move(leave);
+  waitfor(leave->end);
+  lock("all");
   setmod('j');
   move(park);
   waitfor(park->end);
