@@ -15,6 +15,7 @@
 #include "rccx/hw/mjcf.hpp"
 #include "rccx/hw/mujoco_arm.hpp"
 #include "rccx/rccl/manipulator.hpp"
+#include "rccx/rccl/tool_calibration.hpp"
 #include "rccx/rtc/servo_driver.hpp"
 #include "rccx/rtc/simulated_robot.hpp"
 
@@ -270,6 +271,44 @@ TEST(MujocoForce, AFrozenSensorEndsControlWithItsCodeAndTheArmHolds) {
   const kin::JointVector q1 = c.arm.true_position();
   // Held: the servos hunt within their Coulomb friction, a few tenths of a milliradian.
   for (std::size_t j = 0; j < q0.size(); ++j) EXPECT_NEAR(q1[j], q0[j], 1e-3) << "joint " << j + 1;
+}
+
+TEST(MujocoForce, TheToolLoadCalibrationFindsTheToolMuJoCoCarries) {
+  // A 1.2 kg tool whose centre of mass is off its axis, and nothing told to the manipulator.
+  auto scene = std::make_shared<hw::Scene>(*table_scene());
+  scene->tool_mass_kg = 1.2;
+  scene->tool_com_m = {0.01, -0.015, 0.06};
+  scene->tool_length_m = 0.12;
+  Cell c(scene);
+  c.m.set_tool_load({});
+  c.go(c.at("FREE", 0.45, 0.15005, kTable_m + 0.25));
+  force::LoadFit fit;
+  rccl::ToolCalibrationReadings readings;
+  const force::ToolLoad load = rccl::calibrate_tool_load(c.m, {}, &fit, &readings);
+  if (debug()) {
+    std::printf("mass %.4f kg com %.4f %.4f %.4f m rms %.4f N %.5f N m\n", load.mass_kg,
+                load.com_m.x, load.com_m.y, load.com_m.z, fit.rms_force_N, fit.rms_torque_N_m);
+  }
+  EXPECT_NEAR(load.mass_kg, 1.2, 0.01);
+  EXPECT_LT((load.com_m - scene->tool_com_m).norm(), 0.002);
+  EXPECT_LT(fit.rms_force_N, 0.05);
+
+  // At a wrist orientation it never visited, the compensated reading is (nearly) nothing.
+  c.m.set_tool_load(load);
+  kin::JointVector q = c.robot.session->how().q();
+  q[3] += 0.5;
+  q[4] -= 0.4;
+  q[5] += 1.0;
+  c.m.set_mode(rccl::Mode::joint);
+  const rccl::Motion mo = c.m.move(rccl::Position::joints("TURNED", q));
+  ASSERT_EQ(c.m.waitfor(mo.end(), 30s), rccl::WaitResult::reached);
+  c.robot.session->wait_for(500ms);
+  const rtc::How h = c.robot.session->how();
+  const math::Wrench left =
+      force::external_wrench(load, c.m.kinematics().forward(h.q()).R, h.force.wrench);
+  EXPECT_LT(left.force_N.norm(), 0.1);
+  EXPECT_LT(left.torque_N_m.norm(), 0.01);
+  for (const auto& f : c.m.failures()) ADD_FAILURE() << f.message();
 }
 
 }  // namespace
