@@ -13,38 +13,12 @@
 #include <utility>
 #include <vector>
 
+#include "counting_new.hpp"
 #include "rccx/cell/capsule.hpp"
 #include "rccx/cell/collision.hpp"
 #include "rccx/cell/robot_capsules.hpp"
 #include "rccx/kinematics/kinematics.hpp"
 #include "rccx/kinematics/link_frames.hpp"
-
-// ---- counting operator new: the proof that the checks allocate nothing ----------------------
-
-namespace {
-std::atomic<long> g_allocations{0};
-}  // namespace
-
-void* operator new(std::size_t size) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
-  throw std::bad_alloc();
-}
-void* operator new[](std::size_t size) {
-  return operator new(size);
-}
-void operator delete(void* p) noexcept {
-  std::free(p);
-}
-void operator delete[](void* p) noexcept {
-  std::free(p);
-}
-void operator delete(void* p, std::size_t) noexcept {
-  std::free(p);
-}
-void operator delete[](void* p, std::size_t) noexcept {
-  std::free(p);
-}
 
 namespace {
 
@@ -529,7 +503,7 @@ TEST(CollisionWorld, SetConfigurationAndCheckAllocateNothing) {
   }
   std::vector<Contact> out(64);
   std::size_t contacts = 0, found = 0;
-  const long before = g_allocations.load();
+  const long before = rccx::test_support::allocations();
   for (int k = 0; k < 8; ++k) {
     for (std::size_t i = 0; i < world.size(); ++i) {
       world.set_configuration(i, qs[static_cast<std::size_t>(k) * world.size() + i]);
@@ -539,12 +513,12 @@ TEST(CollisionWorld, SetConfigurationAndCheckAllocateNothing) {
     if (world.check_all_pairs()) ++found;
     contacts += world.min_distance(0, 1).distance_m < 0.0 ? 1 : 0;
   }
-  const long after = g_allocations.load();
+  const long after = rccx::test_support::allocations();
   EXPECT_EQ(after - before, 0);
   EXPECT_GT(found + contacts, 0U);  // the loop did work that was not optimised away
   // The counter itself works.
   auto* p = new int(1);
-  EXPECT_GT(g_allocations.load(), after);
+  EXPECT_GT(rccx::test_support::allocations(), after);
   delete p;
 }
 

@@ -20,39 +20,13 @@
 #include <string>
 #include <vector>
 
+#include "counting_new.hpp"
 #include "rccx/force/current_estimate.hpp"
 #include "rccx/force/tool_load.hpp"
 #include "rccx/hw/simulated_puma.hpp"
 #include "rccx/kinematics/kinematics.hpp"
 #include "rccx/kinematics/link_frames.hpp"
 #include "rccx/math/units.hpp"
-
-// ---- counting operator new (this thread only): the proof that the estimate allocates nothing --
-
-namespace {
-thread_local long t_allocations = 0;
-}  // namespace
-
-void* operator new(std::size_t size) {
-  ++t_allocations;
-  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
-  throw std::bad_alloc();
-}
-void* operator new[](std::size_t size) {
-  return operator new(size);
-}
-void operator delete(void* p) noexcept {
-  std::free(p);
-}
-void operator delete[](void* p) noexcept {
-  std::free(p);
-}
-void operator delete(void* p, std::size_t) noexcept {
-  std::free(p);
-}
-void operator delete[](void* p, std::size_t) noexcept {
-  std::free(p);
-}
 
 namespace {
 
@@ -405,7 +379,7 @@ TEST(MotorWrench, AllocatesNothing) {
     qd[j] = 0.1 * static_cast<double>(j) - 0.2;
   }
   const Transform tool = Transform::translation(0, 0, 0.1);
-  const long before = t_allocations;
+  const long before = rccx::test_support::thread_allocations();
   const kin::JointVector friction = force::friction_effort(model, qd);
   const auto a = force::wrench_from_motor_effort(*kinematics, q, motor, gravity, friction,
                                                  {.t6_from_tool = tool});
@@ -413,9 +387,9 @@ TEST(MotorWrench, AllocatesNothing) {
                                                  {.t6_from_tool = tool, .damping = 0.01});
   const Wrench c = force::external_wrench({}, Rot3::rot_x(0.3), a.wrench);
   const Wrench d = force::at_tool(tool, b.wrench);
-  EXPECT_EQ(t_allocations, before);
+  EXPECT_EQ(rccx::test_support::thread_allocations(), before);
   { const auto counted = std::make_unique<double>(1.0); }  // the counter does count
-  EXPECT_EQ(t_allocations, before + 1);
+  EXPECT_EQ(rccx::test_support::thread_allocations(), before + 1);
   EXPECT_TRUE(a.ok && b.ok && std::isfinite(c.force_N.x) && std::isfinite(d.force_N.x));
 }
 

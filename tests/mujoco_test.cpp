@@ -16,6 +16,7 @@
 #include <random>
 #include <string>
 
+#include "counting_new.hpp"
 #include "rccx/hw/mjcf.hpp"
 #include "rccx/hw/mujoco_arm.hpp"
 #include "rccx/hw/rcu.hpp"
@@ -24,13 +25,18 @@
 #include "rccx/math/units.hpp"
 #include "rccx/rtc/simulated_robot.hpp"
 
-// ---- counting allocations: C++'s operator new and MuJoCo's mju_malloc -----------------------
+// ---- counting allocations: C++'s operator new (counting_new.cpp) and MuJoCo's mju_malloc -----
 
 namespace {
-std::atomic<long> g_allocations{0};
+std::atomic<long> g_mujoco_allocations{0};
+
+/// Every allocation so far: operator new's and MuJoCo's.
+long allocations() {
+  return rccx::test_support::allocations() + g_mujoco_allocations.load(std::memory_order_relaxed);
+}
 
 void* counting_malloc(std::size_t size) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
+  g_mujoco_allocations.fetch_add(1, std::memory_order_relaxed);
   return std::malloc(size);
 }
 void counting_free(void* p) {
@@ -42,30 +48,6 @@ const bool g_hooks_installed = [] {
   mju_user_free = counting_free;
   return true;
 }();
-}  // namespace
-
-void* operator new(std::size_t size) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
-  throw std::bad_alloc();
-}
-void* operator new[](std::size_t size) {
-  return operator new(size);
-}
-void operator delete(void* p) noexcept {
-  std::free(p);
-}
-void operator delete[](void* p) noexcept {
-  std::free(p);
-}
-void operator delete(void* p, std::size_t) noexcept {
-  std::free(p);
-}
-void operator delete[](void* p, std::size_t) noexcept {
-  std::free(p);
-}
-
-namespace {
 
 using namespace rccx;
 using hw::MujocoArm;
@@ -417,14 +399,14 @@ TEST(MujocoArm, AServoTickAllocatesNothing) {
   ASSERT_TRUE(p.arm->command(1, move(p.model.ready()[1] - 0.01, 0.02)));
   ASSERT_TRUE(p.arm->command(0, move(0.02, 0.1)));
   p.arm->advance_to(0.01);
-  const long before = g_allocations.load();
+  const long before = allocations();
   math::Wrench w;
   for (int ms = 0; ms < 2000; ++ms) {
     p.arm->advance_to(p.arm->time_s() + 1e-3);
     (void)p.arm->wrist_wrench(w);
     (void)p.arm->read(1);
   }
-  EXPECT_EQ(g_allocations.load() - before, 0);
+  EXPECT_EQ(allocations() - before, 0);
   EXPECT_GT(p.arm->contact_count(), 0);  // the ticks counted include contact
 }
 

@@ -235,4 +235,31 @@ kin::JointVector ArmBase::true_velocity() const noexcept {
   return v;
 }
 
+double ArmBase::servo_effort(const JointState& s, const ServoGains& g, double inertia,
+                             double viscous, double max_effort, double hold, double dt,
+                             double& integral) const noexcept {
+  double tau = 0.0;
+  if (zero_gravity()) {
+    integral = 0.0;
+    tau = hold - kZeroGravityDamping_per_s * inertia * s.qd;
+  } else {
+    const double e = s.setpoint - s.q;
+    const double pd =
+        g.kp * e + g.kd * (s.setpoint_velocity - s.qd) + viscous * s.setpoint_velocity + hold;
+    double next = integral;
+    if (std::abs(g.kp * e) < max_effort) {
+      next = std::clamp(integral + e * dt, -max_effort / g.ki, max_effort / g.ki);
+    }
+    tau = pd + g.ki * next;
+    if (std::abs(tau) < max_effort) integral = next;  // no wind-up while saturated
+  }
+  // The motor: max_effort at rest, falling to zero at the no-load speed when driving along the
+  // motion; braking against the motion keeps the full effort.
+  double drive_limit = max_effort;
+  if (tau * s.qd > 0.0) {
+    drive_limit *= std::max(0.0, 1.0 - std::abs(s.qd) / (kOverspeedFactor * s.max_velocity));
+  }
+  return std::clamp(tau, -drive_limit, drive_limit);
+}
+
 }  // namespace rccx::hw

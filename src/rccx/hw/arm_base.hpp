@@ -32,6 +32,23 @@ inline constexpr double kCalibrationStillFactor = 0.01;
 /// An encoder_error fault shifts the joint's counts by this much.
 inline constexpr std::int64_t kEncoderErrorJump_counts = 4096;
 
+/// Velocity damping in zero gravity, as a multiple of the joint's inertia, 1/s.
+inline constexpr double kZeroGravityDamping_per_s = 20.0;
+
+/// The gains of the joint servo the physical plants share (SimulatedPuma, MujocoArm).
+struct ServoGains {
+  double kp = 0.0;  ///< N m/rad or N/m
+  double ki = 0.0;  ///< N m/(rad s) or N/(m s)
+  double kd = 0.0;  ///< N m s/rad or N s/m
+};
+
+/// Gains that put the three closed-loop poles of a joint of inertia I at -w (rad/s):
+/// Kp = 3 I w^2, Kd = 3 I w, Ki = I w^3.
+constexpr ServoGains servo_gains(double inertia, double bandwidth_rad_per_s) noexcept {
+  const double w = bandwidth_rad_per_s;
+  return {3.0 * inertia * w * w, inertia * w * w * w, 3.0 * inertia * w};
+}
+
 class ArmBase : public SimulatedArm {
  public:
   [[nodiscard]] const kin::RobotModel& model() const noexcept final { return model_; }
@@ -92,6 +109,15 @@ class ArmBase : public SimulatedArm {
   /// One servo period with power on: move q and qd of every joint (the setpoints are already
   /// advanced). In zero gravity the setpoints follow the joints, and the servo must yield.
   virtual void servo_tick(double dt) noexcept = 0;
+  /// The joint servo of the physical plants, one tick of joint `s`: the motor effort (N m or
+  /// N) of  tau = Kp e + Ki int(e) + Kd (v_sp - qd) + B v_sp + hold  (e = setpoint - q, B the
+  /// viscous friction, hold the gravity load), the integrator running only while |Kp e| is
+  /// below max_effort and the output is not saturated (`integral` carries it, e s); limited to
+  /// max_effort, and along the motion on the motor's torque-speed line (zero at
+  /// kOverspeedFactor x max_velocity). Zero gravity: hold - kZeroGravityDamping_per_s I qd.
+  [[nodiscard]] double servo_effort(const JointState& s, const ServoGains& g, double inertia,
+                                    double viscous, double max_effort, double hold, double dt,
+                                    double& integral) const noexcept;
   /// The servo of joint j restarts from the present position (power on, zero gravity off):
   /// drop any state such as an integrator.
   virtual void on_servo_restart(std::size_t j) noexcept { (void)j; }

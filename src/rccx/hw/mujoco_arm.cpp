@@ -67,8 +67,7 @@ MujocoArm::MujocoArm(kin::RobotModel model, const SimulatedArmOptions& options)
       actuator_[i] = id_of(mjOBJ_ACTUATOR, fmt::format("m{}", i + 1));
       arm_bodies_.push_back(id_of(mjOBJ_BODY, fmt::format("link{}", i + 1)));
       const JointPlant& p = plants_[i];
-      const double w = p.bandwidth;
-      gains_[i] = {3.0 * p.inertia * w * w, p.inertia * w * w * w, 3.0 * p.inertia * w};
+      gains_[i] = servo_gains(p.inertia, p.bandwidth);
     }
     arm_bodies_.push_back(id_of(mjOBJ_BODY, "tool"));
     force_adr_ = m_->sensor_adr[id_of(mjOBJ_SENSOR, "ft_force")];
@@ -154,32 +153,11 @@ void MujocoArm::servo_tick(double dt) noexcept {
   std::array<double, kin::kMaxJoints> hold{};
   compute_gravity_load(hold);
   for (std::size_t i = 0; i < n_; ++i) {
-    const JointState& s = joints_[i];
     const JointPlant& p = plants_[i];
-    const double limit = p.max_effort;
-    double tau = 0.0;
-    if (zero_gravity()) {
-      integral_[i] = 0.0;
-      tau = hold[i] - kZeroGravityDamping_per_s * p.inertia * s.qd;
-    } else {
-      const Gains& g = gains_[i];
-      const double e = s.setpoint - s.q;
-      const double pd = g.kp * e + g.kd * (s.setpoint_velocity - s.qd) +
-                        p.viscous * s.setpoint_velocity + hold[i];
-      double integral = integral_[i];
-      if (std::abs(g.kp * e) < limit) {
-        integral = std::clamp(integral + e * dt, -limit / g.ki, limit / g.ki);
-      }
-      tau = pd + g.ki * integral;
-      if (std::abs(tau) < limit) integral_[i] = integral;  // no wind-up while saturated
-    }
-    double drive_limit = limit;
-    if (tau * s.qd > 0.0) {
-      drive_limit *= std::max(0.0, 1.0 - std::abs(s.qd) / (kOverspeedFactor * s.max_velocity));
-    }
-    tau_[i] = std::clamp(tau, -drive_limit, drive_limit);
+    tau_[i] = servo_effort(joints_[i], gains_[i], p.inertia, p.viscous, p.max_effort, hold[i], dt,
+                           integral_[i]);
     d_->ctrl[actuator_[i]] = tau_[i];
-    d_->qfrc_applied[dof_[i]] = s.external;
+    d_->qfrc_applied[dof_[i]] = joints_[i].external;
   }
   mj_step2(m_, d_);
   for (int k = 1; k < scene_.substeps; ++k) mj_step(m_, d_);

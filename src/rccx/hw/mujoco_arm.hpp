@@ -42,14 +42,7 @@ namespace rccx::hw {
 
 class MujocoArm final : public ArmBase {
  public:
-  /// Velocity damping in zero gravity, as a multiple of the joint's inertia, 1/s.
-  static constexpr double kZeroGravityDamping_per_s = 20.0;
-
-  struct Gains {
-    double kp = 0.0;  ///< N m/rad or N/m
-    double ki = 0.0;  ///< N m/(rad s) or N/(m s)
-    double kd = 0.0;  ///< N m s/rad or N s/m
-  };
+  using Gains = ServoGains;
 
   /// Builds the MJCF of `model` in options.scene (an empty scene when null) and loads it from
   /// memory. Throws std::invalid_argument for an unusable model, scene or initial pose, or when

@@ -30,14 +30,13 @@ kin::RobotModel&& checked(kin::RobotModel&& model) {
 
 SimulatedPuma::SimulatedPuma(kin::RobotModel model, const SimulatedArmOptions& options)
     : ArmBase(checked(std::move(model)), options), gravity_(this->model()) {
-  const double w = kServoBandwidth_rad_per_s;
   for (std::size_t i = 0; i < n_; ++i) {
     const kin::JointDynamics& d = this->model().joints[i].dynamics;
     inertia_[i] = d.inertia;
     viscous_[i] = d.viscous_friction;
     coulomb_[i] = d.coulomb_friction;
     max_effort_[i] = d.max_effort;
-    gains_[i] = {3.0 * d.inertia * w * w, d.inertia * w * w * w, 3.0 * d.inertia * w};
+    gains_[i] = servo_gains(d.inertia, kServoBandwidth_rad_per_s);
   }
 }
 
@@ -50,31 +49,8 @@ kin::JointVector SimulatedPuma::motor_effort() const noexcept {
 void SimulatedPuma::servo_tick(double dt) noexcept {
   const kin::JointVector hold = gravity_.load(true_position());
   for (std::size_t i = 0; i < n_; ++i) {
-    const JointState& s = joints_[i];
-    const double limit = max_effort_[i];
-    double tau = 0.0;
-    if (zero_gravity()) {
-      integral_[i] = 0.0;
-      tau = hold[i] - kZeroGravityDamping_per_s * inertia_[i] * s.qd;
-    } else {
-      const Gains& g = gains_[i];
-      const double e = s.setpoint - s.q;
-      const double pd = g.kp * e + g.kd * (s.setpoint_velocity - s.qd) +
-                        viscous_[i] * s.setpoint_velocity + hold[i];
-      double integral = integral_[i];
-      if (std::abs(g.kp * e) < limit) {
-        integral = std::clamp(integral + e * dt, -limit / g.ki, limit / g.ki);
-      }
-      tau = pd + g.ki * integral;
-      if (std::abs(tau) < limit) integral_[i] = integral;  // no wind-up while saturated
-    }
-    // The motor: max_effort at rest, falling to zero at the no-load speed when driving along
-    // the motion; braking against the motion keeps the full effort.
-    double drive_limit = limit;
-    if (tau * s.qd > 0.0) {
-      drive_limit *= std::max(0.0, 1.0 - std::abs(s.qd) / (kOverspeedFactor * s.max_velocity));
-    }
-    tau_[i] = std::clamp(tau, -drive_limit, drive_limit);
+    tau_[i] = servo_effort(joints_[i], gains_[i], inertia_[i], viscous_[i], max_effort_[i], hold[i],
+                           dt, integral_[i]);
   }
 
   const double h = dt / kPlantSubsteps;

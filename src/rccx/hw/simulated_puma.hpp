@@ -34,14 +34,8 @@ class SimulatedPuma final : public ArmBase {
   static constexpr double kServoBandwidth_rad_per_s = 40.0;
   /// Plant integration sub-steps per servo tick.
   static constexpr int kPlantSubsteps = 10;
-  /// Velocity damping in zero gravity, as a multiple of the joint's inertia, 1/s.
-  static constexpr double kZeroGravityDamping_per_s = 20.0;
 
-  struct Gains {
-    double kp = 0.0;  ///< N m/rad or N/m
-    double ki = 0.0;  ///< N m/(rad s) or N/(m s)
-    double kd = 0.0;  ///< N m s/rad or N s/m
-  };
+  using Gains = ServoGains;
 
   /// Needs every joint's dynamics (inertia and max_effort > 0); throws std::invalid_argument
   /// otherwise, or for an unusable initial pose.

@@ -1,6 +1,7 @@
 #include "rccx/rtc/sample_log.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <chrono>
 #include <cstdlib>
@@ -8,6 +9,14 @@
 #include "rccx/io/console.hpp"
 
 namespace rccx::rtc {
+
+std::vector<std::string> sample_log_columns(std::size_t dof) {
+  std::vector<std::string> columns{"t", "seg"};
+  for (std::size_t i = 1; i <= dof; ++i) columns.push_back(fmt::format("q{}", i));
+  for (std::size_t i = 1; i <= dof; ++i) columns.push_back(fmt::format("qm{}", i));
+  for (const char* c : {"x", "y", "z", "ax", "ay", "az"}) columns.emplace_back(c);
+  return columns;
+}
 
 SampleLog::SampleLog(const std::filesystem::path& file, const kin::RobotModel& model)
     : name_(file.string()), path_(file), kinematics_(kin::make_kinematics(model)) {
@@ -18,11 +27,7 @@ SampleLog::SampleLog(const std::filesystem::path& file, const kin::RobotModel& m
   }
   // The header goes with the first rows: a disk that is full from the start is a write that
   // fails (said at once, the log not saved), not a bad file name.
-  const std::size_t n = model.dof();
-  std::string header = "t,seg";
-  for (std::size_t i = 1; i <= n; ++i) header += fmt::format(",q{}", i);
-  for (std::size_t i = 1; i <= n; ++i) header += fmt::format(",qm{}", i);
-  header += ",x,y,z,ax,ay,az\n";
+  std::string header = fmt::format("{}\n", fmt::join(sample_log_columns(model.dof()), ","));
   writer_ =
       std::thread([this, header = std::move(header)]() mutable { write_loop(std::move(header)); });
 }

@@ -19,6 +19,7 @@
 #include <memory>
 #include <stdexcept>
 #include <thread>
+#include <vector>
 
 #include <string>
 
@@ -27,6 +28,11 @@
 #include "rccx/rtc/types.hpp"
 
 namespace rccx::rtc {
+
+/// The log's columns for a robot of `dof` joints, in order: t, seg, q1..qN (commanded),
+/// qm1..qmN (measured), x, y, z, ax, ay, az (the tool's position and approach vector). What the
+/// header says and what readers of the log (rccx view --log, rccx plot) expect.
+std::vector<std::string> sample_log_columns(std::size_t dof);
 
 /// A log file that cannot be used.
 class LogError : public std::runtime_error {

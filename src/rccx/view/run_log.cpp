@@ -4,6 +4,7 @@
 
 #include "rccx/io/file.hpp"
 #include "rccx/io/parse.hpp"
+#include "rccx/rtc/sample_log.hpp"
 
 namespace rccx::view {
 
@@ -50,9 +51,8 @@ RunLog parse_run_log(std::string_view text, std::string_view origin) {
         throw RunLogError(
             fmt::format("{}:1: {} joints; rccx logs at most {}", origin, log.dof, kin::kMaxJoints));
       }
-      for (std::size_t i = 1; i <= log.dof; ++i) header.push_back(fmt::format("q{}", i));
-      for (std::size_t i = 1; i <= log.dof; ++i) header.push_back(fmt::format("qm{}", i));
-      for (const char* c : {"x", "y", "z", "ax", "ay", "az"}) header.emplace_back(c);
+      header = rtc::sample_log_columns(log.dof);         // the columns rtc::SampleLog writes
+      header.erase(header.begin(), header.begin() + 2);  // t and seg, checked above
       for (std::size_t i = 0; i < header.size(); ++i) {
         if (cells[i + 2] != header[i]) {
           throw RunLogError(fmt::format("{}:1: column {} is {}, expected {}: not {}", origin, i + 3,
