@@ -33,6 +33,10 @@
 #include "rtc.h"
 // clang-format on
 
+namespace rccx::compat {
+struct PositionBox;
+}
+
 /// What a MANIP points to: a robot of the open cell and its own settings.
 struct rccl_manip {
   std::string name;
@@ -44,6 +48,8 @@ struct rccl_manip {
   std::size_t failures_seen = 0;
   bool told_ended = false;
   std::map<std::uint64_t, std::string> motion_names;
+  /// motion id -> its position, whose POS.code the motion's end sets (as for one robot)
+  std::map<std::uint64_t, rccx::compat::PositionBox*> motion_boxes;
 };
 
 namespace rccx::compat {

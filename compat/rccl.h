@@ -591,6 +591,13 @@ int mnp_last_motion(const MANIP* m);
  * failure). Returns 0, or RTC_E_ARGUMENT (a null handle, a motion never queued, a bad event).
  */
 int mnp_after(MANIP* m, MANIP* other, int motion, int event);
+/*
+ * The cell's objects (names, separated by commas or spaces: "board,xy_stage") that the tool of
+ * m's next mnp_move may touch: the collision check lets the tool's capsules come within the
+ * margin of them and no others ("" for none, as every motion starts). Returns 0, or
+ * RTC_E_ARGUMENT naming the cell's objects for an unknown name.
+ */
+int mnp_touch(MANIP* m, const char* objects);
 
 /**
  * A joint start: the next mnp_move of each listed robot (a NULL-terminated list of MANIP*)

@@ -21,6 +21,23 @@ namespace {
 /// Prints the motions of robot m that failed since the last call; true when its control has
 /// ended (printed once).
 bool cell_report(rccl_manip& m) {
+  // POS.code of each motion's position, as move() sets it for one robot: 0 when it ended,
+  // RCCL_NEXTMOVE / RCCL_ONF ended early, RTC_E_MOTION failed or cancelled (a collision stop).
+  for (const rc::MotionEvent& e : m.arm->take_events()) {
+    const auto it = m.motion_boxes.find(e.id);
+    if (it == m.motion_boxes.end()) continue;
+    if (e.kind == rc::EventKind::ended) {
+      int code = 0;
+      if (e.message() == rc::kNextmoveText) {
+        code = m.arm->contact(rc::Motion{e.id}) ? RCCL_ONF : RCCL_NEXTMOVE;
+      }
+      it->second->shown->code = code;
+      m.motion_boxes.erase(it);
+    } else if (e.kind == rc::EventKind::failed || e.kind == rc::EventKind::cancelled) {
+      it->second->shown->code = RTC_E_MOTION;
+      m.motion_boxes.erase(it);
+    }
+  }
   const std::vector<rc::MotionEvent>& f = m.arm->failures();
   std::size_t cancelled = 0;
   for (; m.failures_seen < f.size(); ++m.failures_seen) {
@@ -311,6 +328,7 @@ int mnp_move(MANIP* m, POS_PTR p) {
     it->second->queued.push_back(target);
     r->next = rc::StartWhen{};
     r->motion_names[mo.id] = it->second->name;
+    r->motion_boxes[mo.id] = it->second.get();
     refresh();
     return RTC_OK;
   });
@@ -328,6 +346,33 @@ int mnp_move(MANIP* m, POS_PTR p) {
 int mnp_last_motion(const MANIP* m) {
   const rccl_manip* r = known(m);
   return r == nullptr ? 0 : static_cast<int>(r->arm->last_queued());
+}
+
+int mnp_touch(MANIP* m, const char* objects) {
+  rccl_manip* r = known(m);
+  if (r == nullptr) return bad_handle("mnp_touch");
+  return guarded("mnp_touch", Say::print, RTC_E_ARGUMENT, [&] {
+    std::vector<std::string> names;
+    std::string word;
+    for (const char* c = objects != nullptr ? objects : "";; ++c) {
+      if (*c == '\0' || *c == ',' || *c == ' ') {
+        if (!word.empty()) names.push_back(word);
+        word.clear();
+        if (*c == '\0') break;
+      } else {
+        word += *c;
+      }
+    }
+    try {
+      r->next.touch = state().cell->objects(names);
+    } catch (const std::invalid_argument& e) {
+      return fail(RTC_E_ARGUMENT,
+                  fmt::format("mnp_touch({}, \"{}\"): {}", r->name,
+                              objects != nullptr ? objects : "", e.what()),
+                  Say::print);
+    }
+    return RTC_OK;
+  });
 }
 
 int mnp_after(MANIP* m, MANIP* other, int motion, int event) {

@@ -64,11 +64,12 @@ struct Pad {
   double y_mm;
 };
 // The Microbo probes from the +x side; the PUMA holds the board's -x edge (GRASP), so the pads
-// stay at x >= -20 mm: the arms' capsules then keep more than 40 mm apart (see the closest
-// approach the program prints).
-constexpr std::array kPads{Pad{"TP1", -20, -25}, Pad{"TP2", 5, -30}, Pad{"TP3", 30, -25},
-                           Pad{"TP4", 35, 0},    Pad{"TP5", 30, 25}, Pad{"TP6", 5, 30},
-                           Pad{"TP7", -20, 25},  Pad{"U1", 5, 0}};
+// stay at x >= -5 mm: the probe then keeps more than the collision check's margin and braking
+// allowance from the PUMA's gripper, 45 mm away in x (see the closest approach the program
+// prints).
+constexpr std::array kPads{Pad{"TP1", -5, -25}, Pad{"TP2", 10, -30}, Pad{"TP3", 30, -25},
+                           Pad{"TP4", 35, 0},   Pad{"TP5", 30, 25},  Pad{"TP6", 10, 30},
+                           Pad{"TP7", -5, 25},  Pad{"U1", 10, 0}};
 /// Touching this pad starts the PUMA's slow move: the next ones are probed on a moving board.
 constexpr std::size_t kStartMovingAfter = 2;  // TP3
 /// The pad repaired (a longer dwell with the hand closed): U1, a component's lead.
@@ -235,12 +236,23 @@ int main(int argc, char** argv) {
     above.push_back(probe(std::string("ABOVE_") + pad.name, kProbeAbove));
     touch.push_back(probe(std::string("TOUCH_") + pad.name, 0.0));
   }
-  // Where the Microbo waits, out of the PUMA's way: d3 at 200 mm puts its wrist 150 mm in x
-  // from the board's centre, 300 mm up; tool down as in its ready pose.
+  // Where the Microbo waits, out of the PUMA's way: its arm drawn in (d3 200 mm), 300 mm up and
+  // turned aside, clear of where the PUMA's hand swings down to the board; tool down as in its
+  // ready pose.
   kin::JointVector wait_q = microbo_kin.model().ready();
+  wait_q[0] = 0.8;  // turned 46 deg away from where the PUMA's hand comes down (world -y)
   wait_q[1] = 0.300;
   wait_q[2] = 0.200;
   const auto m_wait = rccl::Position::joints("MICROBO_WAIT", wait_q);
+  // On the way there it lifts its arm, draws it in, and only then lowers it: its probe stands
+  // over the board at the ready pose, and the collision check stops any motion that brings a
+  // part closer to an object it may not touch.
+  kin::JointVector up_q = microbo_kin.model().ready();
+  up_q[1] = microbo_kin.model().joints[1].upper - 0.005;  // not at the stop: the RCU overshoots
+  kin::JointVector drawn_q = up_q;
+  drawn_q[2] = wait_q[2];
+  const auto m_up = rccl::Position::joints("MICROBO_UP", up_q);
+  const auto m_drawn = rccl::Position::joints("MICROBO_DRAWN_IN", drawn_q);
   fmt::print("{}\n{}\n", p_present->describe(), touch.front()->describe());
 
   // --- Measurement ----------------------------------------------------------------------------
@@ -305,35 +317,66 @@ int main(int argc, char** argv) {
   microbo.set_velocity(80_mm, 45_deg);
   // The arms start 57 mm apart (both ready poses reach over the board): the Microbo backs off
   // first, and the PUMA sets off once that motion has ended.
+  microbo.move(m_up);
+  microbo.move(m_drawn);
   const rccl::Motion back_off = microbo.move(m_wait);
-  puma.move(p_over, c.after("microbo", back_off.end()));
+  // The PUMA's hand swings down past the waiting Microbo's arm: slowly, so that the collision
+  // check's braking allowance (which grows with speed) leaves them room.
+  // The gripper comes down over the board's edge, closes on it over the stage, and carries the
+  // board (whose box stays where the cell file puts it): those motions may touch both.
+  const rccl::StartWhen grip = c.touching({"board", "xy_stage"});
+  const std::uint64_t board_and_stage = grip.touch;
+  rccl::StartWhen after_back_off = c.after("microbo", back_off.end());
+  after_back_off.touch = board_and_stage;
+  puma.set_velocity(30_mm, 20_deg);
+  puma.move(p_over, after_back_off);
   puma.set_mode(rccl::Mode::cartesian);
   puma.set_velocity(30_mm, 30_deg);
-  const rccl::Motion descend = puma.move(p_grip);
+  const rccl::Motion descend = puma.move(p_grip, grip);
   wait(puma, descend.end());
   puma.set_hand(true);
-  wait(puma, puma.dwell(0.5).end());  // the fingers close on the board's edge
+  wait(puma, puma.dwell(0.5, grip).end());  // the fingers close on the board's edge
   puma.set_velocity(50_mm, 30_deg);
-  puma.move(p_lift);
-  const rccl::Motion present = puma.move(p_present);
+  puma.move(p_lift, grip);
+  const rccl::Motion present = puma.move(p_present, grip);
+  if (!good) {  // the pick failed: the Microbo's goals on the board would be nowhere
+    for (rccl::Manipulator* m : {&puma, &microbo}) {
+      for (const rccl::MotionEvent& f : m->failures()) {
+        if (!f.message().empty())
+          fmt::print(stderr, "{}: {}\n", m == &puma ? "PUMA" : "Microbo", f.message());
+      }
+    }
+    fmt::print(stderr, "the PUMA could not pick the board up; nothing is probed\n");
+    return 1;
+  }
 
   // --- 2-4. Probe, with the board moving for some pads, and repair one -------------------------
   std::array<PadResult, kPads.size()> results{};
   microbo.set_mode(rccl::Mode::cartesian);
-  microbo.set_velocity(40_mm, 45_deg);
+  // Slowly among the PUMA's hand and the board: the collision check's braking allowance grows with
+  // speed, and the Microbo's hand passes within 50 mm of the PUMA's flange.
+  microbo.set_velocity(15_mm, 10_deg);
   // The Microbo starts only once the board stands still where it is presented.
-  const rccl::Motion first_above = microbo.move(above[0], c.after("puma", present.end()));
+  // The collision check keeps every part of both arms off the cell's objects, unless a motion
+  // names what its tool may touch: the probe touches the board; the Microbo's arm and hand may
+  // not.
+  const rccl::StartWhen probe = c.touching({"board"});
+  rccl::StartWhen after_present = c.after("puma", present.end());
+  after_present.touch = probe.touch;
+  const rccl::Motion first_above = microbo.move(above[0], after_present);
   wait(microbo, first_above.start());
   const double presented_s = puma.report(present).end_s;
 
   rccl::Motion slow{};
   for (std::size_t i = 0; i < kPads.size() && good; ++i) {
-    if (i > 0) microbo.move(above[i]);
-    const rccl::Motion down = microbo.move(touch[i]);
+    if (i > 0) microbo.move(above[i], probe);
+    const rccl::Motion down = microbo.move(touch[i], probe);
     if (i == kStartMovingAfter) {
       // Once the Microbo has touched TP3, the PUMA carries the board slowly along y.
       puma.set_velocity(moving_speed_mm_s * 1e-3, 10_deg);
-      slow = puma.move(p_moved, c.after("microbo", down.end()));
+      rccl::StartWhen after_touch = c.after("microbo", down.end());
+      after_touch.touch = board_and_stage;
+      slow = puma.move(p_moved, after_touch);
     }
     wait(microbo, down.end());
     results[i].touched_s = microbo.report(down).end_s;
@@ -346,22 +389,24 @@ int main(int argc, char** argv) {
     } else {
       measure(kPads[i], kDwellS, results[i]);
     }
-    microbo.move(above[i]);  // up
+    microbo.move(above[i], probe);  // up
   }
   if (slow.id != 0) wait(puma, slow.end());
   // --- 5. Both back ----------------------------------------------------------------------------
   microbo.set_mode(rccl::Mode::joint);
   const rccl::Motion away = microbo.move(m_wait);
   puma.set_velocity(50_mm, 30_deg);
-  puma.move(p_lift, c.after("microbo", away.end()));  // the Microbo out of its way first
+  rccl::StartWhen after_away = c.after("microbo", away.end());  // out of the PUMA's way first
+  after_away.touch = board_and_stage;
+  puma.move(p_lift, after_away);
   puma.set_velocity(30_mm, 30_deg);
-  wait(puma, puma.move(p_grip).end());
+  wait(puma, puma.move(p_grip, grip).end());
   puma.set_hand(false);
-  wait(puma, puma.dwell(0.5).end());
-  puma.move(p_over);
+  wait(puma, puma.dwell(0.5, grip).end());
+  puma.move(p_over, grip);
   puma.set_mode(rccl::Mode::joint);
   puma.set_velocity(80_mm, 45_deg);
-  puma.move(puma.park());
+  puma.move(puma.park(), grip);  // from over the board's edge, where it let go
   wait(puma, puma.completed());
   const double end_s = puma_session.how().time_s;
 

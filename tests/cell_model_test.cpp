@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "rccx/cell/cell.hpp"
 #include "rccx/cell/cell_model.hpp"
 #include "rccx/kinematics/kinematics.hpp"
 #include "rccx/math/units.hpp"
@@ -117,10 +118,76 @@ json valid_cell() {
   })");
 }
 
+/// Robot b of valid_cell(), parsed.
+cell::CellRobot valid_model() {
+  return cell::parse_cell(valid_cell().dump(), "good.json", {}).robots[1];
+}
+
 struct BadRow {
   std::function<void(json&)> change;
   std::string says;  ///< a part of the message (the key)
 };
+
+TEST(CellFile, ShapesAndMountingLoad) {
+  json j = valid_cell();
+  j["robots"][1]["shapes"] = json::array({{{"name", "hand"},
+                                           {"frame", "t6"},
+                                           {"from_m", {0, 0, 0}},
+                                           {"to_m", {0, 0, 0.05}},
+                                           {"radius_m", 0.02}},
+                                          {{"name", "slide_tail"},
+                                           {"frame", 3},
+                                           {"from_m", {0, 0, 0}},
+                                           {"to_m", {0, 0, -0.1}},
+                                           {"radius_m", 0.03},
+                                           {"note", "behind the column"}},
+                                          {{"name", "plinth"},
+                                           {"frame", "base"},
+                                           {"from_m", {0, 0, 0}},
+                                           {"to_m", {0, 0, 0.1}},
+                                           {"radius_m", 0.1}}});
+  j["robots"][1]["mounted_on"] = "table";
+  const cell::CellModel c = cell::parse_cell(j.dump(), "good.json", {});
+  ASSERT_EQ(c.robots[1].shapes.size(), 3U);
+  EXPECT_EQ(c.robots[1].shapes[0].frame, 6U);
+  EXPECT_EQ(c.robots[1].shapes[1].frame, 3U);
+  EXPECT_EQ(c.robots[1].shapes[2].frame, 0U);
+  EXPECT_DOUBLE_EQ(c.robots[1].shapes[1].to_m.z, -0.1);
+  EXPECT_EQ(c.robots[1].mounted_on, "table");
+  // Shapes in T6 replace the default tool capsule; without them the tool gets one.
+  EXPECT_EQ(cell::Cell::shapes_of(c.robots[1]).size(), 3U);
+  const std::vector<cell::ShapeSpec> tool = cell::Cell::shapes_of(valid_model());
+  ASSERT_EQ(tool.size(), 1U);
+  EXPECT_EQ(tool[0].name, "tool");
+  EXPECT_DOUBLE_EQ(tool[0].to_m.z, 0.1);
+  EXPECT_DOUBLE_EQ(tool[0].radius_m, 0.1);
+}
+
+TEST(CellFile, ARobotInsideAnObjectIsRefusedSayingWhatToDo) {
+  // The Microbo's base joint and column start on the table top: inside the table unless the
+  // cell says it stands there.
+  json j = valid_cell();
+  j["robots"][0]["base"]["xyz_m"] = {0, 0, 0.3};  // the PUMA's shoulder above the table
+  try {
+    cell::Cell c(cell::parse_cell(j.dump(), "t.json", {}));
+    ADD_FAILURE() << "a robot standing inside the table was accepted";
+  } catch (const cell::CellFileError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("robot b's link 1 lies 100.0 mm inside object table"), std::string::npos) << m;
+    EXPECT_NE(m.find("\"mounted_on\": \"table\""), std::string::npos) << m;
+  }
+  j["robots"][1]["mounted_on"] = "table";
+  EXPECT_NO_THROW(cell::Cell(cell::parse_cell(j.dump(), "t.json", {})));
+  // A part that is not the base's stays refused, mounted or not: the post through the arm.
+  j["objects"][1]["pose"] = {{"xyz_m", {0.5 - 0.325, 0, 0.275}}};
+  try {
+    cell::Cell c(cell::parse_cell(j.dump(), "t.json", {}));
+    ADD_FAILURE() << "an arm through a post was accepted";
+  } catch (const cell::CellFileError& e) {
+    EXPECT_NE(std::string(e.what()).find("inside object post"), std::string::npos) << e.what();
+    EXPECT_EQ(std::string(e.what()).find("mounted_on"), std::string::npos) << e.what();
+  }
+}
 
 TEST(CellFile, ValidTestCellLoads) {
   const cell::CellModel c = cell::parse_cell(valid_cell().dump(), "good.json", {});
@@ -132,6 +199,13 @@ TEST(CellFile, ValidTestCellLoads) {
 
 TEST(CellFile, BadFilesNameTheKey) {
   const auto robot = [](json& j, std::size_t i) -> json& { return j["robots"][i]; };
+  const auto probe = [](json frame) {
+    return json{{"name", "probe"},
+                {"frame", frame},
+                {"from_m", {0, 0, 0}},
+                {"to_m", {0, 0, 0.1}},
+                {"radius_m", 0.005}};
+  };
   const std::vector<BadRow> rows = {
       {[](json& j) { j.erase("robots"); }, "missing \"robots\""},
       {[](json& j) { j["robots"] = json::array(); }, "\"robots\" has 0"},
@@ -236,6 +310,50 @@ TEST(CellFile, BadFilesNameTheKey) {
        },
        "\"xyz_m\" [2] must be a number"},
       {[](json& j) { j["frames"][0]["name"] = std::string(33, 'f'); }, "at most 32"},
+      // The collision model's shapes and mounting (issue 30).
+      {[&](json& j) { robot(j, 1)["shapes"] = json::object(); }, "\"shapes\" must be a list"},
+      {[&](json& j) { robot(j, 1)["shapes"] = {probe(json("t7"))}; }, "\"frame\" must be"},
+      {[&](json& j) { robot(j, 1)["shapes"] = {probe(json(7))}; }, "\"frame\" is 7; 1 to 6"},
+      {[&](json& j) { robot(j, 1)["shapes"] = {probe(json(0))}; }, "\"frame\" is 0; 1 to 6"},
+      {[&](json& j) {
+         json p = probe(json("t6"));
+         p["radius_m"] = -0.01;
+         robot(j, 1)["shapes"] = {p};
+       },
+       "\"radius_m\" is -0.01"},
+      {[&](json& j) {
+         json p = probe(json("t6"));
+         p["to_m"] = {0, 0};
+         robot(j, 1)["shapes"] = {p};
+       },
+       "\"to_m\" must be 3 numbers"},
+      {[&](json& j) {
+         json p = probe(json("t6"));
+         p["length_m"] = 0.1;
+         robot(j, 1)["shapes"] = {p};
+       },
+       "unknown key \"length_m\""},
+      {[&](json& j) {
+         robot(j, 1)["shapes"] = {probe(json("t6")), probe(json("base"))};
+       },
+       "shape names must be unique"},
+      {[&](json& j) {
+         json p = probe(json("base"));
+         p["name"] = "my probe";
+         robot(j, 1)["shapes"] = {p};
+       },
+       "shape 1: \"name\""},
+      {[&](json& j) {
+         robot(j, 1)["shapes"] = json::array();
+         for (int k = 0; k < 17; ++k) {
+           json p = probe(json("t6"));
+           p["name"] = "p" + std::to_string(k);
+           robot(j, 1)["shapes"].push_back(p);
+         }
+       },
+       "at most 16"},
+      {[&](json& j) { robot(j, 1)["mounted_on"] = "tabel"; },
+       "\"mounted_on\" names no object of the cell: \"tabel\"; its objects: table, post"},
   };
   for (std::size_t i = 0; i < rows.size(); ++i) {
     json j = valid_cell();

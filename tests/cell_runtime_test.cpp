@@ -195,13 +195,79 @@ TEST(CellRuntime, TwoArmsDrivenTowardsEachOtherStopOutsideTheMargin) {
   for (rccl::Manipulator* m : {&puma, &microbo}) {
     ASSERT_FALSE(m->failures().empty());
     const std::string msg(m->failures().front().message());
-    EXPECT_NE(msg.find("puma link "), std::string::npos) << msg;
-    EXPECT_NE(msg.find("microbo link "), std::string::npos) << msg;
+    EXPECT_NE(msg.find("collision stop: puma "), std::string::npos) << msg;
+    EXPECT_NE(msg.find(" and microbo "), std::string::npos) << msg;
     EXPECT_TRUE(m->session().controlling()) << "a collision stop is a failed motion, not an end";
   }
-  // Stopped, they may move apart again.
-  const rccl::Motion back = microbo.move(microbo.park());
-  EXPECT_EQ(microbo.waitfor(back.end(), 20s), rccl::WaitResult::reached) << failures_of(microbo);
+  // Stopped inside each other's braking zone, both may move apart again at once, each back the
+  // way it came (the braking zone grows with speed: they go slowly), with no further stop.
+  const std::uint64_t stops = c->collision_stops();
+  puma.set_velocity(0.03, 0.3);
+  microbo.set_velocity(0.03, 0.3);
+  const rccl::Motion pa = puma.move(puma.park());
+  const rccl::Motion ma = microbo.move(microbo.park());
+  EXPECT_EQ(puma.waitfor(pa.end(), 20s), rccl::WaitResult::reached) << failures_of(puma);
+  EXPECT_EQ(microbo.waitfor(ma.end(), 20s), rccl::WaitResult::reached) << failures_of(microbo);
+  EXPECT_EQ(c->collision_stops(), stops);
+  EXPECT_GE(closest_m, margin_m);
+}
+
+TEST(CellRuntime, TwoArmsStanding40mmApartAreSeparatedWithNoStop) {
+  // The Microbo's arm swings from its ready pose towards the PUMA's wrist (a straight line in
+  // its joints) until its closest part is 40 mm from the PUMA's: inside the zone where any
+  // approach is stopped.
+  cell::CellModel model = cell::load_cell_file(kCvarl);
+  kin::RobotModel& mb = model.robots[1].model;
+  const kin::JointVector from = mb.ready();
+  kin::JointVector to = from;
+  to[0] = -0.337;  // theta1 towards the PUMA's wrist, 127 mm to the side at 330 mm
+  to[1] = mb.joints[1].upper;
+  to[2] = 0.385;
+  const auto gap = [&](double s) {
+    for (std::size_t j = 0; j < 3; ++j) mb.joints[j].ready = from[j] + s * (to[j] - from[j]);
+    std::vector<cell::RobotCapsules> arms;
+    for (const cell::CellRobot& r : model.robots) {
+      arms.emplace_back(r.model, r.link_radius_m, r.base, cell::Cell::shapes_of(r));
+    }
+    return cell::CollisionWorld(std::move(arms), 0.0).min_distance(0, 1).distance_m;
+  };
+  double lo = 0.0, hi = 1.0;
+  ASSERT_GT(gap(lo), 0.04);
+  ASSERT_LT(gap(hi), 0.04) << "the Microbo cannot reach within 40 mm of the PUMA";
+  for (int k = 0; k < 40; ++k) ((gap((lo + hi) / 2) > 0.04) ? lo : hi) = (lo + hi) / 2;
+  ASSERT_NEAR(gap(lo), 0.04, 1e-4);
+  const auto c = std::make_unique<cell::Cell>(model);
+  double closest_m = 1e9;
+  c->set_cycle_observer([&](std::uint32_t) {
+    closest_m = std::min(closest_m, c->collision_world().min_distance(0, 1).distance_m);
+  });
+  c->start();
+  rccl::Manipulator& puma = c->robot("puma");
+  rccl::Manipulator& microbo = c->robot("microbo");
+  // Both at once, slowly (the braking zone grows with speed): the Microbo swings back the way
+  // it came (joint mode) and the PUMA draws its hand back along its axis (Cartesian).
+  puma.set_velocity(0.03, 0.3);
+  microbo.set_velocity(0.03, 0.3);
+  puma.set_mode(rccl::Mode::cartesian);
+  math::Transform back = c->tool_sample("puma").pose;
+  back.p = back.p - back.R.a * 0.06 + math::Vec3{0, 0, 0.02};
+  const rccl::Motion pa = puma.move(world_position(*c, "puma", "PA", back));
+  const rccl::Motion ma = microbo.move(microbo.park());
+  EXPECT_EQ(puma.waitfor(pa.end(), 20s), rccl::WaitResult::reached) << failures_of(puma);
+  EXPECT_EQ(microbo.waitfor(ma.end(), 20s), rccl::WaitResult::reached) << failures_of(microbo);
+  // Then each to its own side, tool down (joint mode: the PUMA's wrist turns the long way).
+  puma.set_mode(rccl::Mode::joint);
+  const rccl::Motion pb =
+      puma.move(world_position(*c, "puma", "PB", down_at(kAbove + math::Vec3{-0.12, 0.05, 0.05})));
+  const rccl::Motion mb2 = microbo.move(
+      world_position(*c, "microbo", "MB", down_at(kAbove + math::Vec3{0.14, -0.02, 0.03})));
+  EXPECT_EQ(puma.waitfor(pb.end(), 20s), rccl::WaitResult::reached) << failures_of(puma);
+  EXPECT_EQ(microbo.waitfor(mb2.end(), 20s), rccl::WaitResult::reached) << failures_of(microbo);
+  EXPECT_EQ(c->collision_stops(), 0U);
+  EXPECT_GE(closest_m, 0.04 - 1e-4) << "they came closer on the way apart";
+  const double apart = c->collision_world().min_distance(0, 1).distance_m;
+  EXPECT_GT(apart, 0.1);
+  RecordProperty("apart_mm", std::to_string(apart * 1e3));
 }
 
 namespace {
@@ -228,7 +294,9 @@ TEST(CellRuntime, OneRobotsFaultStopsTheOthersWhichHoldAndMayMoveAgain) {
   const auto c = cell::Cell::load(kCvarl);
   c->start();
   rccl::Manipulator& microbo = c->robot("microbo");
-  const math::Vec3 m1 = kAbove + math::Vec3{0.10, 0.0, 0.0};
+  // The Microbo draws its arm in (d3 alone, its wrist at the ready height) while the PUMA's
+  // flange, stopped by the fault, stands near it.
+  const math::Vec3 m1 = kAbove + math::Vec3{0.12, 0.0, -0.0016};
   const rccl::Motion b = fault_the_puma_while_both_move(*c, m1);
   EXPECT_EQ(microbo.waitfor(b.end(), 20s), rccl::WaitResult::failed);
   ASSERT_FALSE(microbo.failures().empty());
@@ -261,7 +329,7 @@ TEST(CellRuntime, WithoutStopOnFaultTheOthersGoOn) {
   // And it goes on moving.
   microbo.set_mode(rccl::Mode::cartesian);
   const rccl::Motion b2 =
-      microbo.move(world_position(*c, "microbo", "M2", down_at(m1 + math::Vec3{0.0, 0.03, 0.0})));
+      microbo.move(world_position(*c, "microbo", "M2", down_at(m1 + math::Vec3{0.0, -0.03, 0.0})));
   EXPECT_EQ(microbo.waitfor(b2.end(), 20s), rccl::WaitResult::reached) << failures_of(microbo);
   EXPECT_TRUE(microbo.failures().empty());
 }

@@ -19,6 +19,7 @@
 #include "rccx/cell/robot_capsules.hpp"
 #include "rccx/kinematics/kinematics.hpp"
 #include "rccx/kinematics/link_frames.hpp"
+#include "rccx/math/units.hpp"
 
 namespace {
 
@@ -278,18 +279,184 @@ TEST(RobotCapsules, FollowTheLinksFromFrameOriginToFrameOrigin) {
   }
 }
 
-TEST(RobotCapsules, SkipZeroLengthPieces) {
-  // PUMA 560: a2 (upper arm), d3 and a3 (shoulder offset, elbow), d4 (forearm).
+TEST(RobotCapsules, EveryJointHasACapsuleAndShapesFollowTheirFrames) {
+  // The wrists (the PUMA's links 5 and 6, the Microbo's 1, 4, 5 and 6) have no DH length: each
+  // is a sphere at its joint, so that no part of the arm is left out.
+  std::mt19937_64 rng(5);
   const double r = 0.05;
-  const RobotCapsules puma(kin::builtin_robot("puma560"), std::span(&r, 1));
-  ASSERT_EQ(puma.capsules().size(), 4U);
-  EXPECT_EQ(puma.capsules()[0].link, 1);
-  EXPECT_EQ(puma.capsules()[1].link, 2);
-  EXPECT_EQ(puma.capsules()[2].link, 2);
-  EXPECT_EQ(puma.capsules()[3].link, 3);
-  // The Microbo's prismatic joints always have their d part, whatever its length now.
+  for (const char* name : kCapsuleRobots) {
+    SCOPED_TRACE(name);
+    const kin::RobotModel model = kin::builtin_robot(name);
+    const std::vector<cell::ShapeSpec> shapes{
+        {"pedestal", 0, {0, 0, -0.3}, {0, 0, -0.1}, 0.07},
+        {"probe", model.dof(), {0, 0, 0.02}, {0.01, 0, 0.12}, 0.004}};
+    const Transform base{math::Rot3::from_rpy(0.4, 0.1, -0.2), {0.2, 0.3, -0.1}};
+    RobotCapsules robot(model, std::span(&r, 1), base, shapes);
+    const auto kinematics = kin::make_kinematics(model);
+    for (int k = 0; k < 200; ++k) {
+      const kin::JointVector q = random_q(model, rng);
+      ASSERT_TRUE(robot.update(q));
+      std::array<Transform, kin::kMaxJoints> frames;
+      kin::link_frames(model, q, frames);
+      std::vector<bool> seen(model.dof(), false);
+      std::size_t named = 0;
+      for (const Capsule& c : robot.capsules()) {
+        if (c.shape < 0) {
+          seen[c.link] = true;
+          continue;
+        }
+        ++named;
+        const std::string_view n = robot.shape_name(c);
+        // The shape's points, placed by forward kinematics (the tool) or the base alone.
+        const Transform frame = n == "probe" ? base * kinematics->forward(q) : base;
+        const cell::ShapeSpec& spec = n == "probe" ? shapes[1] : shapes[0];
+        ASSERT_LT((c.p0_m - frame * spec.from_m).norm(), 1e-12) << n;
+        ASSERT_LT((c.p1_m - frame * spec.to_m).norm(), 1e-12) << n;
+        EXPECT_EQ(c.tool, n == "probe");
+        EXPECT_EQ(c.mounting, n == "pedestal");
+      }
+      EXPECT_EQ(named, 2U);
+      for (std::size_t i = 0; i < model.dof(); ++i) EXPECT_TRUE(seen[i]) << "link " << i + 1;
+      // Mounting capsules reach the base origin whatever the joints do.
+      for (const Capsule& c : robot.capsules()) {
+        if (!c.mounting || c.shape >= 0) continue;
+        EXPECT_LT(std::min((c.p0_m - base.p).norm(), (c.p1_m - base.p).norm()), 1e-12);
+      }
+    }
+  }
+  // The Microbo: its base joint and its column rest on what it stands on, its arm does not.
   const RobotCapsules microbo(kin::builtin_robot("microbo"), std::span(&r, 1));
-  EXPECT_EQ(microbo.capsules().size(), 2U);
+  std::size_t mounting = 0;
+  for (const Capsule& c : microbo.capsules()) mounting += c.mounting ? 1 : 0;
+  EXPECT_EQ(mounting, 2U);
+  EXPECT_EQ(microbo.capsules().size(), 6U);  // sphere, column, arm, three wrist spheres
+  const std::vector<cell::ShapeSpec> bad{{"x", 7, {}, {}, 0.01}};
+  EXPECT_THROW(
+      RobotCapsules(kin::builtin_robot("microbo"), std::span(&r, 1), Transform::identity(), bad),
+      std::invalid_argument);
+}
+
+// The signed distance from x to an axis-aligned box of half extents h at the origin, written
+// from the faces: inside, minus the nearest face's distance; outside, the clamped point's.
+double box_distance(const Vec3& x, const Vec3& h) {
+  const Vec3 clamped{std::clamp(x.x, -h.x, h.x), std::clamp(x.y, -h.y, h.y),
+                     std::clamp(x.z, -h.z, h.z)};
+  const double out = (x - clamped).norm();
+  if (out > 0.0) return out;
+  return -std::min({h.x - std::abs(x.x), h.y - std::abs(x.y), h.z - std::abs(x.z)});
+}
+
+double cylinder_distance(const Vec3& x, double r, double hh) {
+  const double rho = std::hypot(x.x, x.y);
+  if (rho <= r && std::abs(x.z) <= hh) return -std::min(r - rho, hh - std::abs(x.z));
+  const double dr = std::max(rho - r, 0.0), dz = std::max(std::abs(x.z) - hh, 0.0);
+  return std::hypot(dr, dz);
+}
+
+TEST(CapsuleSolid, DistanceAgreesWithDenseSampling) {
+  std::mt19937_64 rng(23);
+  std::uniform_real_distribution<double> u(0.02, 0.3);
+  for (int k = 0; k < 400; ++k) {
+    const Transform pose{math::Rot3::from_rpy(u(rng) * 10, u(rng) * 10, u(rng) * 10),
+                         random_vec(rng, 0.2)};
+    const bool box = k % 2 == 0;
+    const Vec3 size{u(rng), u(rng), u(rng)};
+    const cell::Solid solid =
+        box ? cell::make_box(size, pose) : cell::make_cylinder(size.x / 2, size.z, pose);
+    Capsule c;
+    c.p0_m = random_vec(rng, 0.4);
+    c.p1_m = k % 7 == 0 ? c.p0_m : random_vec(rng, 0.4);
+    c.radius_m = u(rng) * 0.1;
+    const Transform inv = pose.inverse();
+    double best = INFINITY;
+    constexpr int kSamples = 20000;
+    for (int i = 0; i <= kSamples; ++i) {
+      const Vec3 x = inv * (c.p0_m + (c.p1_m - c.p0_m) * (static_cast<double>(i) / kSamples));
+      best = std::min(
+          best, box ? box_distance(x, size * 0.5) : cylinder_distance(x, size.x / 2, size.z / 2));
+    }
+    const double expected = best - c.radius_m;
+    const cell::SolidDistance d = cell::capsule_solid_distance(c, solid);
+    // Sampling finds the minimum within one step of the axis (Lipschitz 1 along it).
+    const double step = (c.p1_m - c.p0_m).norm() / kSamples;
+    EXPECT_LE(d.distance_m, expected + 1e-9) << k;
+    EXPECT_GE(d.distance_m, expected - step - 1e-9) << k;
+    // The box of the solid holds it.
+    for (int ax = 0; ax < 3; ++ax) {
+      const Vec3 centre = pose.p;
+      EXPECT_LE(solid.bounds.lo_m[ax], centre[ax]);
+      EXPECT_GE(solid.bounds.hi_m[ax], centre[ax]);
+    }
+  }
+}
+
+TEST(CollisionWorld, ThreatsOnlyWhilePartsApproach) {
+  // Two Microbos facing each other 1 m apart, arms drawn in, and a table under both.
+  const kin::RobotModel m = kin::builtin_robot("microbo");
+  const double r = 0.04;
+  const std::vector<cell::ShapeSpec> tool{{"probe", m.dof(), {0, 0, 0}, {0, 0, 0.125}, 0.005}};
+  std::vector<RobotCapsules> robots;
+  robots.emplace_back(m, std::span(&r, 1), Transform::translation(-0.5, 0, 0), tool);
+  robots.emplace_back(m, std::span(&r, 1), Transform{math::Rot3::rot_z(math::kPi), {0.5, 0, 0}},
+                      tool);
+  robots[0].set_mounted_on(0);
+  robots[1].set_mounted_on(0);
+  std::vector<cell::Solid> solids{
+      cell::make_box({2, 1, 0.04}, Transform::translation(0, 0, -0.02)),
+      cell::make_box({0.1, 0.1, 0.05}, Transform::translation(-0.05, 0, 0.025))};
+  CollisionWorld world(std::move(robots), 0.01, std::move(solids));
+  std::array<cell::Threat, 8> out{};
+  kin::JointVector a = m.ready(), b = m.ready();
+  a[2] = 0.3;   // d3: the first wrist at x = -0.2 m
+  b[2] = 0.45;  // the second at x = 0.05 m
+  world.set_configuration(0, a);
+  world.set_configuration(1, b);
+  EXPECT_EQ(world.threats(out), 0U) << "standing on the table is not a collision";
+  EXPECT_EQ(world.threats(out), 0U);
+  // The first arm reaches out towards the second: the hands approach.
+  world.set_allowance(0, 0.05);
+  const long allocations_before = rccx::test_support::allocations();
+  for (double d3 = 0.3; d3 < 0.45; d3 += 0.01) {
+    a[2] = d3;
+    world.set_configuration(0, a);
+    const std::size_t n = world.threats(out);
+    const double gap = world.min_distance(0, 1).distance_m;
+    if (gap < 0.01 + 0.05) {
+      ASSERT_GE(n, 1U) << "d3 " << d3;
+      EXPECT_FALSE(out[0].solid);
+      EXPECT_LT(out[0].distance_m, out[0].before_m);
+      break;
+    }
+    EXPECT_EQ(n, 0U) << "d3 " << d3 << " gap " << gap;
+  }
+  // Moving back apart, even within the zone, is no threat.
+  for (double d3 = a[2]; d3 > 0.3; d3 -= 0.01) {
+    a[2] = d3;
+    world.set_configuration(0, a);
+    EXPECT_EQ(world.threats(out), 0U) << "d3 " << d3;
+  }
+  // Down onto the block: the probe approaches it, a threat, unless the motion may touch it.
+  b[2] = 0.3;  // the second arm drawn in first (moving apart: no threat)
+  world.set_configuration(1, b);
+  EXPECT_EQ(world.threats(out), 0U);
+  a[2] = 0.45;  // the first wrist over the block's edge, x = -0.05 m
+  world.set_configuration(0, a);
+  EXPECT_EQ(world.threats(out), 0U);
+  a[1] = 0.2;  // d2 lowest: the probe's tip 75 mm above the table, 25 mm above the block
+  world.set_configuration(0, a);
+  std::size_t n = world.threats(out);
+  ASSERT_EQ(n, 1U);
+  EXPECT_TRUE(out[0].solid);
+  EXPECT_EQ(out[0].b, 1U);
+  world.set_touch(0, 0b10);
+  a[1] = 0.275;
+  world.set_configuration(0, a);
+  (void)world.threats(out);
+  a[1] = 0.2;
+  world.set_configuration(0, a);
+  EXPECT_EQ(world.threats(out), 0U) << "the probe may touch the block";
+  // Against robots and solids alike, the check allocated nothing.
+  EXPECT_EQ(rccx::test_support::allocations(), allocations_before);
 }
 
 TEST(RobotCapsules, RefuseBadRadiiAndBadJointValues) {
@@ -502,6 +669,7 @@ TEST(CollisionWorld, SetConfigurationAndCheckAllocateNothing) {
     for (std::size_t i = 0; i < world.size(); ++i) qs.push_back(random_q(c.models[i], rng));
   }
   std::vector<Contact> out(64);
+  std::vector<cell::Threat> threats(world.max_threats() + 1);
   std::size_t contacts = 0, found = 0;
   const long before = rccx::test_support::allocations();
   for (int k = 0; k < 8; ++k) {
@@ -512,6 +680,9 @@ TEST(CollisionWorld, SetConfigurationAndCheckAllocateNothing) {
     contacts += world.contacts(out);
     if (world.check_all_pairs()) ++found;
     contacts += world.min_distance(0, 1).distance_m < 0.0 ? 1 : 0;
+    world.set_allowance(k % world.size(), 0.01 * k);
+    world.set_touch(k % world.size(), 1U);
+    contacts += world.threats(threats);
   }
   const long after = rccx::test_support::allocations();
   EXPECT_EQ(after - before, 0);

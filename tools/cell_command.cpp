@@ -91,6 +91,16 @@ int run_show(const ShowArgs& args) {
                 {"reach_m", cell::reach_m(r)},
                 {"link_radius_m", r.link_radius_m}};
       item["tool"] = r.tool ? pose_json(*r.tool) : json(nullptr);
+      json shapes = json::array();
+      for (const cell::RobotShape& k : r.shapes) {
+        shapes.push_back({{"name", k.name},
+                          {"frame", k.frame},
+                          {"from_m", {k.from_m.x, k.from_m.y, k.from_m.z}},
+                          {"to_m", {k.to_m.x, k.to_m.y, k.to_m.z}},
+                          {"radius_m", k.radius_m}});
+      }
+      item["shapes"] = shapes;
+      item["mounted_on"] = r.mounted_on.empty() ? json(nullptr) : json(r.mounted_on);
       robots.push_back(item);
     }
     json objects = json::array();
@@ -134,6 +144,15 @@ int run_show(const ShowArgs& args) {
                r.model.name, r.model_file.empty() ? "" : " (" + r.model_file + ")", ms(c.period(i)),
                r.period_multiple, cell::reach_m(r) * 1e3, pose_text(r.base));
     if (r.tool) fmt::print("    tool: {}\n", pose_text(*r.tool));
+    // The collision model's shapes beyond the links (docs/CELL.md), and what it stands on.
+    for (const cell::RobotShape& k : r.shapes) {
+      const std::string frame = k.frame == 0               ? std::string("base")
+                                : k.frame == r.model.dof() ? std::string("t6")
+                                                           : fmt::format("link {}", k.frame);
+      fmt::print("    shape {}: {} mm long in {}, radius {:.1f} mm\n", k.name,
+                 fmt::format("{:.1f}", (k.to_m - k.from_m).norm() * 1e3), frame, k.radius_m * 1e3);
+    }
+    if (!r.mounted_on.empty()) fmt::print("    stands on: {}\n", r.mounted_on);
   }
   if (!c.objects.empty()) fmt::print("objects ({}):\n", c.objects.size());
   for (const cell::CellObject& o : c.objects) {

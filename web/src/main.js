@@ -131,7 +131,7 @@ class RobotView {
     const linkMat = new THREE.MeshStandardMaterial({ color: colour, metalness: 0.2, roughness: 0.6 });
     const jointMat = new THREE.MeshStandardMaterial({ color: 0x30343c, metalness: 0.4, roughness: 0.5 });
     const capsuleMat = new THREE.MeshStandardMaterial({ color: 0xff5050, transparent: true,
-      opacity: 0.18, depthWrite: false });
+      opacity: 0.3, depthWrite: false });
     this.group = new THREE.Group();
     scene.add(this.group);
     const cyl = new THREE.CylinderGeometry(1, 1, 1, 16);
@@ -166,6 +166,15 @@ class RobotView {
         this.capsules.push(caps);
       }
     }
+    // The collision model's shapes beyond the links (pedestal, flange, hand, tool): a capsule
+    // each, in its frame (0: the base, i: link i's, the last: T6).
+    this.shapes = (desc.shapes || []).map((k) => {
+      const body = new THREE.Mesh(cyl, capsuleMat);
+      body.scale.set(k.radius, 1, k.radius);
+      const ends = [0, 1].map(() => new THREE.Mesh(new THREE.SphereGeometry(k.radius, 16, 12), capsuleMat));
+      this.group.add(body, ...ends);
+      return { k, body, ends };
+    });
     const baseMesh = new THREE.Mesh(cyl, jointMat);
     baseMesh.scale.set(this.thick * 3, this.thick * 1.5, this.thick * 3);
     baseMesh.quaternion.setFromUnitVectors(Y, new THREE.Vector3(0, 0, 1));
@@ -214,6 +223,14 @@ class RobotView {
         placeBetween(c1, mid, o[i + 1]);
         s.position.copy(o[i + 1]);
       }
+    }
+    for (const { k, body, ends } of this.shapes) {
+      const frame = f[Math.min(k.frame, f.length - 1)];
+      const p0 = new THREE.Vector3(...k.from).applyMatrix4(frame);
+      const p1 = new THREE.Vector3(...k.to).applyMatrix4(frame);
+      placeBetween(body, p0, p1);
+      ends[0].position.copy(p0);
+      ends[1].position.copy(p1);
     }
     this.tool.matrix.copy(f[f.length - 1]).multiply(this.toolMatrix);
   }

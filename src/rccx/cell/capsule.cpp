@@ -1,5 +1,6 @@
 #include "rccx/cell/capsule.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -89,6 +90,99 @@ CapsuleDistance capsule_distance(const Capsule& a, const Capsule& b) noexcept {
     out.on_b_m = c.on_second_m;
   }
   return out;
+}
+
+namespace {
+
+math::Vec3 max0(const math::Vec3& v) noexcept {
+  return {std::max(v.x, 0.0), std::max(v.y, 0.0), std::max(v.z, 0.0)};
+}
+
+Aabb world_box(const math::Transform& pose, const math::Vec3& half_m) noexcept {
+  // The extent of an oriented box along each world axis: |R| h.
+  const math::Rot3& R = pose.R;
+  const math::Vec3 e{
+      std::abs(R.n.x) * half_m.x + std::abs(R.o.x) * half_m.y + std::abs(R.a.x) * half_m.z,
+      std::abs(R.n.y) * half_m.x + std::abs(R.o.y) * half_m.y + std::abs(R.a.y) * half_m.z,
+      std::abs(R.n.z) * half_m.x + std::abs(R.o.z) * half_m.y + std::abs(R.a.z) * half_m.z};
+  return {pose.p - e, pose.p + e};
+}
+
+}  // namespace
+
+Solid make_box(const math::Vec3& size_m, const math::Transform& pose) noexcept {
+  Solid s;
+  s.kind = Solid::Kind::box;
+  s.half_m = size_m * 0.5;
+  s.pose = pose;
+  s.inverse = pose.inverse();
+  s.bounds = world_box(pose, s.half_m);
+  return s;
+}
+
+Solid make_cylinder(double radius_m, double height_m, const math::Transform& pose) noexcept {
+  Solid s;
+  s.kind = Solid::Kind::cylinder;
+  s.radius_m = radius_m;
+  s.half_height_m = height_m / 2.0;
+  s.half_m = {radius_m, radius_m, s.half_height_m};  // the box around it
+  s.pose = pose;
+  s.inverse = pose.inverse();
+  s.bounds = world_box(pose, s.half_m);
+  return s;
+}
+
+double signed_distance(const Solid& solid, const math::Vec3& p_m) noexcept {
+  const math::Vec3 p = solid.inverse * p_m;
+  if (solid.kind == Solid::Kind::box) {
+    const math::Vec3 q{std::abs(p.x) - solid.half_m.x, std::abs(p.y) - solid.half_m.y,
+                       std::abs(p.z) - solid.half_m.z};
+    const double inside = std::min(std::max({q.x, q.y, q.z}), 0.0);
+    return max0(q).norm() + inside;
+  }
+  const double radial = std::hypot(p.x, p.y) - solid.radius_m;
+  const double axial = std::abs(p.z) - solid.half_height_m;
+  const double inside = std::min(std::max(radial, axial), 0.0);
+  return std::hypot(std::max(radial, 0.0), std::max(axial, 0.0)) + inside;
+}
+
+SolidDistance capsule_solid_distance(const Capsule& c, const Solid& s) noexcept {
+  // Golden-section search of a convex function over [0, 1]: 44 steps shrink the interval by
+  // 0.618^44 < 1e-9.
+  const math::Vec3 d = c.p1_m - c.p0_m;
+  const auto f = [&](double t) { return signed_distance(s, c.p0_m + d * t); };
+  constexpr double kInvPhi = 0.6180339887498949;
+  double lo = 0.0, hi = 1.0;
+  double x1 = hi - kInvPhi * (hi - lo), x2 = lo + kInvPhi * (hi - lo);
+  double f1 = f(x1), f2 = f(x2);
+  if (d.x * d.x + d.y * d.y + d.z * d.z > kPointLength2) {
+    for (int k = 0; k < 44; ++k) {
+      if (f1 <= f2) {
+        hi = x2;
+        x2 = x1;
+        f2 = f1;
+        x1 = hi - kInvPhi * (hi - lo);
+        f1 = f(x1);
+      } else {
+        lo = x1;
+        x1 = x2;
+        f1 = f2;
+        x2 = lo + kInvPhi * (hi - lo);
+        f2 = f(x2);
+      }
+    }
+  }
+  // The ends too: the minimum of a convex function on [0, 1] may sit at one.
+  double best_t = f1 <= f2 ? x1 : x2;
+  double best = std::min(f1, f2);
+  for (const double t : {0.0, 1.0}) {
+    const double v = f(t);
+    if (v < best) {
+      best = v;
+      best_t = t;
+    }
+  }
+  return {best - c.radius_m, c.p0_m + d * best_t};
 }
 
 }  // namespace rccx::cell

@@ -30,7 +30,49 @@ struct Capsule {
   double radius_m = 0.0;
   Aabb bounds;            ///< the capsule's box, radius included
   std::uint8_t link = 0;  ///< the joint that moves it (0-based: DH link link + 1)
+  /// -1: a piece of a DH link (or the sphere at its joint); else the index of the robot's
+  /// named shape (RobotCapsules::shape_name): a pedestal, a flange, a hand, a tool.
+  std::int8_t shape = -1;
+  /// Fixed to the flange (T6): the hand and the tool, what a motion that may touch an object
+  /// touches it with.
+  bool tool = false;
+  /// Reaches the robot's base origin in every configuration (a base shape, the first links'
+  /// pieces from the origin): what may rest on the object the robot stands on.
+  bool mounting = false;
 };
+
+/// A solid obstacle of the cell: a box of half extents half_m, or a cylinder of radius_m and
+/// half height half_height_m along its z, centred on `pose` (world <- the solid's centre).
+struct Solid {
+  enum class Kind : std::uint8_t { box, cylinder };
+  Kind kind = Kind::box;
+  math::Vec3 half_m;
+  double radius_m = 0.0;
+  double half_height_m = 0.0;
+  math::Transform pose;
+  math::Transform inverse;  ///< pose^-1, kept so that each distance does not invert it
+  Aabb bounds;              ///< in the world
+};
+
+/// A solid from its shape and pose (computes the inverse and the world box).
+[[nodiscard]] Solid make_box(const math::Vec3& size_m, const math::Transform& pose) noexcept;
+[[nodiscard]] Solid make_cylinder(double radius_m, double height_m,
+                                  const math::Transform& pose) noexcept;
+
+/// Signed distance from a point (world) to a solid's surface, m: negative inside, by the
+/// depth to the nearest face.
+[[nodiscard]] double signed_distance(const Solid& solid, const math::Vec3& p_m) noexcept;
+
+/// The distance between a capsule and a solid.
+struct SolidDistance {
+  double distance_m = 0.0;  ///< between the surfaces; negative when they overlap
+  math::Vec3 on_axis_m;     ///< the point of the capsule's axis nearest the solid
+};
+
+/// Capsule against solid: the signed distance of the solid is convex along the capsule's axis,
+/// so a golden-section search over the axis finds its minimum (to 1e-9 of the axis' length);
+/// the capsule's radius is then taken off.
+[[nodiscard]] SolidDistance capsule_solid_distance(const Capsule& c, const Solid& s) noexcept;
 
 /// The box around a capsule.
 [[nodiscard]] inline Aabb bounds_of(const math::Vec3& p0_m, const math::Vec3& p1_m,

@@ -12,17 +12,6 @@ namespace rccx::cell {
 
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
-
-// The collision world's margin each tick: the cell's margin plus twice the largest braking
-// allowance of this tick, with headroom, so that the broad phase passes only pairs that may
-// need a stop soon. The headroom keeps a pair that a stop may concern tracked a tick ahead (its
-// last distance tells approaching from moving apart): an allowance at most quadruples in a
-// tick (the speed of a joint at most doubles from a_j P to 2 a_j P, the allowance goes with its
-// square), and one from rest is far below kHeadroom_m.
-constexpr double kHeadroom = 4.0;
-constexpr double kHeadroom_m = 0.05;
-
 rtc::SessionOptions group_options(const CellModel& m, const CellOptions& o) {
   rtc::SessionOptions so;
   so.period = m.base_period;
@@ -31,6 +20,13 @@ rtc::SessionOptions group_options(const CellModel& m, const CellOptions& o) {
   so.one_thread = o.one_thread;
   so.spin_before_tick = o.spin_before_tick;
   return so;
+}
+
+/// "link 4", or a shape's name, without allocating.
+std::string_view part_text(std::array<char, 16>& buf, std::string_view shape, int link) {
+  if (!shape.empty()) return shape;
+  const auto r = fmt::format_to_n(buf.data(), buf.size(), "link {}", link);
+  return {buf.data(), static_cast<std::size_t>(r.out - buf.data())};
 }
 
 /// R(dt) from angular velocity w (world frame) applied to R.
@@ -79,14 +75,38 @@ double Cell::braking_fast(const Robot& r, const kin::JointVector& q0,
   return d;
 }
 
+std::vector<ShapeSpec> Cell::shapes_of(const CellRobot& robot) {
+  std::vector<ShapeSpec> out;
+  bool hand = false;
+  for (const RobotShape& s : robot.shapes) {
+    out.push_back({s.name, s.frame, s.from_m, s.to_m, s.radius_m});
+    hand = hand || s.frame == robot.model.dof();
+  }
+  // A tool the file gives no shape for is a capsule to the tool point, as thick as the last
+  // link: what is there is not known, so not thinner than the arm.
+  if (robot.tool && !hand) {
+    const double r = robot.link_radius_m.empty() ? 0.0 : robot.link_radius_m.back();
+    out.push_back({"tool", robot.model.dof(), {0, 0, 0}, robot.tool->p, r});
+  }
+  return out;
+}
+
 kin::JointVector Cell::levers_m(const CellRobot& robot) {
   const kin::RobotModel& m = robot.model;
   kin::JointVector lever(m.dof());
+  // How far a shape fixed in frame f reaches from that frame's origin.
+  std::array<double, kin::kMaxJoints + 1> reach{};
+  for (const ShapeSpec& s : shapes_of(robot)) {
+    if (s.frame == 0 || s.frame > m.dof()) continue;  // the base's shapes do not move
+    reach[s.frame] =
+        std::max(reach[s.frame], std::max(s.from_m.norm(), s.to_m.norm()) + s.radius_m);
+  }
   // Joint j's axis passes through frame j-1's origin, where link j begins: every point of the
   // links it moves is within their lengths of it, their capsules' surfaces a radius further.
   double beyond = robot.tool ? robot.tool->p.norm() : 0.0;
   double radius = 0.0;
   for (std::size_t j = m.dof(); j-- > 0;) {
+    beyond = std::max(beyond, reach[j + 1]);  // the shapes of link j+1's frame
     const kin::Joint& k = m.joints[j];
     const double r = robot.link_radius_m.size() == m.dof() ? robot.link_radius_m[j]
                                                            : robot.link_radius_m.front();
@@ -101,13 +121,60 @@ kin::JointVector Cell::levers_m(const CellRobot& robot) {
   return lever;
 }
 
+void Cell::check_clear_at_start() const {
+  // A robot that starts inside an object cannot be checked against it: the cell is wrong.
+  for (std::size_t i = 0; i < world_->size(); ++i) {
+    for (std::size_t k = 0; k < world_->solids().size(); ++k) {
+      const SolidContact c = world_->min_solid_distance(i, k);
+      if (!(c.distance_m < 0.0)) continue;
+      const RobotCapsules& r = world_->robot(i);
+      const Capsule& cap = r.capsules()[c.capsule];
+      throw CellFileError(fmt::format(
+          "cell {}: robot {}'s {} lies {:.1f} mm inside object {} at its ready pose; move the "
+          "robot or the object{}",
+          model_.name, model_.robots[i].name, part_name(r, cap), -c.distance_m * 1e3,
+          model_.objects[k].name,
+          cap.mounting ? fmt::format(", or say that it stands there (\"mounted_on\": \"{}\")",
+                                     model_.objects[k].name)
+                       : ""));
+    }
+  }
+}
+
+std::uint64_t Cell::objects(const std::vector<std::string>& names) const {
+  std::uint64_t bits = 0;
+  for (const std::string& name : names) {
+    std::size_t k = 0;
+    while (k < model_.objects.size() && model_.objects[k].name != name) ++k;
+    if (k == model_.objects.size()) {
+      std::vector<std::string> known;
+      for (const CellObject& o : model_.objects) known.push_back(o.name);
+      throw std::invalid_argument(
+          fmt::format("cell {}: no object \"{}\"; its objects: {}", model_.name, name,
+                      known.empty() ? "none" : fmt::format("{}", fmt::join(known, ", "))));
+    }
+    if (k >= 64) {
+      throw std::invalid_argument(fmt::format(
+          "cell {}: object \"{}\" is number {}; a motion may touch only the first 64 objects",
+          model_.name, name, k + 1));
+    }
+    bits |= std::uint64_t{1} << k;
+  }
+  return bits;
+}
+
+rccl::StartWhen Cell::touching(const std::vector<std::string>& names) const {
+  rccl::StartWhen w;
+  w.touch = objects(names);
+  return w;
+}
+
 Cell::Cell(CellModel model, CellOptions options)
     : model_(std::move(model)),
       options_(options),
       group_(std::make_unique<rtc::SessionGroup>(group_options(model_, options_))) {
   validate(model_);
   std::vector<RobotCapsules> capsules;
-  double widest_allowance_m = 0.0;
   for (std::size_t i = 0; i < model_.robots.size(); ++i) {
     const CellRobot& cr = model_.robots[i];
     auto r = std::make_unique<Robot>();
@@ -121,14 +188,20 @@ Cell::Cell(CellModel model, CellOptions options)
     r->tool = cr.tool.value_or(math::Transform::identity());
     r->period_s = std::chrono::duration<double>(model_.period(i)).count();
     r->lever_m = levers_m(cr);
-    capsules.emplace_back(cr.model, cr.link_radius_m, cr.base);
+    const std::vector<ShapeSpec> shapes = shapes_of(cr);
+    capsules.emplace_back(cr.model, cr.link_radius_m, cr.base, shapes);
+    if (!cr.mounted_on.empty()) {
+      for (std::size_t k = 0; k < model_.objects.size(); ++k) {
+        if (model_.objects[k].name == cr.mounted_on)
+          capsules.back().set_mounted_on(static_cast<int>(k));
+      }
+    }
     // Before its first setpoint a robot's tool frame is its ready pose.
     const kin::JointVector ready = cr.model.ready();
     ToolSample s;
     s.pose = cr.base * r->manipulator->kinematics().forward(ready) * r->tool;
     r->published.store(s);
     r->last = s;
-    // The largest allowance a robot can need: at its top speeds.
     const rccl::GeneratorOptions& g = r->manipulator->generator().options();
     r->generator = &r->manipulator->generator();
     r->dof = cr.model.dof();
@@ -139,23 +212,18 @@ Cell::Cell(CellModel model, CellOptions options)
     }
     generators_.push_back(r->generator);
     sessions_.push_back(r->session);
-    kin::JointVector q1 = ready;
-    for (std::size_t j = 0; j < q1.size(); ++j) q1[j] += g.max_velocity[j] * r->period_s;
-    widest_allowance_m =
-        std::max(widest_allowance_m,
-                 braking_m(cr.model, ready, q1, g.max_acceleration, r->period_s, r->lever_m));
     robots_.push_back(std::move(r));
   }
-  // The world reports every pair that could need a stop; on_cycle compares each with the
-  // margin plus the two robots' allowances at that tick.
-  // Two robots' allowances at most, whatever their number: the broad phase stays local.
-  widest_margin_m_ = model_.collision_margin_m + 2.0 * widest_allowance_m;
-  world_ = std::make_unique<CollisionWorld>(std::move(capsules), widest_margin_m_);
-  const std::size_t n = robots_.size();
-  contacts_.resize(n * (n - 1) / 2 + 1);
-  last_distance_m_.assign(n * n, kInf);
-  seen_.assign(n * n, 0);
-  tracked_.reserve(contacts_.size());  // the loop pushes within it: no allocation
+  std::vector<Solid> solids;
+  for (const CellObject& o : model_.objects) {
+    solids.push_back(o.shape.kind == ShapeKind::box
+                         ? make_box(o.shape.size_m, o.pose)
+                         : make_cylinder(o.shape.radius_m, o.shape.height_m, o.pose));
+  }
+  world_ = std::make_unique<CollisionWorld>(std::move(capsules), model_.collision_margin_m,
+                                            std::move(solids));
+  check_clear_at_start();
+  threats_.resize(world_->max_threats() + 1);
   group_->set_robot_hook([this](std::size_t i, std::uint32_t) { on_robot(i); });
   group_->set_cycle_hook([this](std::uint32_t tick) { on_cycle(tick); });
 }
@@ -433,17 +501,23 @@ void Cell::on_robot(std::size_t i) noexcept {
   r.fresh = true;
   r.last_t_s = t;
   r.braking_m = braking_fast(r, g.previous_setpoint(), q);
+  world_->set_allowance(i, r.braking_m);
+  // The running motion's touch set; after the last motion ended, still its own until another
+  // starts: the arm settles at rest where that motion left it (and nothing else moves it).
+  if (const std::uint64_t id = g.last_motion(); id != 0) {
+    const rccl::MotionSettings* settings = g.running_settings(id);
+    r.touch = settings != nullptr ? settings->may_touch : 0;
+  }
+  world_->set_touch(i, r.touch);
   r.valid = true;
 }
 
 void Cell::on_cycle(std::uint32_t tick) noexcept {
-  double braking_max_m = 0.0;  // the largest allowance of this tick
   const std::size_t n = robots_.size();
   for (std::size_t i = 0; i < n; ++i) {
     if (i + 2 < n) {  // the next robots' lines this pass reads, ahead of use
       __builtin_prefetch(robots_[i + 2].get(), 1, 3);
       __builtin_prefetch(&generators_[i + 2]->ledger(), 0, 3);
-      __builtin_prefetch(sessions_[i + 2], 0, 3);
     }
     Robot& r = *robots_[i];
     r.ledger.copy_from(r.generator->ledger());  // for the gates of the next tick
@@ -452,72 +526,51 @@ void Cell::on_cycle(std::uint32_t tick) noexcept {
       r.last = r.next;
       r.fresh = false;
     }
-    if (r.valid && r.generator->last_setpoint().size() == r.dof) {
-      braking_max_m = std::max(braking_max_m, r.braking_m);
-    }
   }
-  if (options_.collision_checks) {
-    world_->set_margin(
-        std::min(widest_margin_m_,
-                 model_.collision_margin_m + 2.0 * (kHeadroom * braking_max_m + kHeadroom_m)));
-    check_collisions();
-  }
+  if (options_.collision_checks) check_collisions();
   publish_ledgers();
   if (observer_) observer_(tick);
 }
 
 void Cell::check_collisions() noexcept {
-  const std::size_t n = robots_.size();
-  const std::size_t found = world_->contacts(contacts_);
-  // A pair not reported is farther than the world's margin: as good as infinitely far.
-  std::vector<double>& last = last_distance_m_;
-  const std::size_t reported = std::min(found, contacts_.size());
+  const std::size_t found = world_->threats(threats_);
+  const std::size_t reported = std::min(found, threats_.size());
   for (std::size_t k = 0; k < reported; ++k) {
-    const Contact& c = contacts_[k];
-    Robot& a = *robots_[c.robot_a];
-    Robot& b = *robots_[c.robot_b];
-    const std::size_t pair = c.robot_a * n + c.robot_b;
-    seen_[pair] = 1;
-    const double before = last[pair];
-    last[pair] = c.distance_m;
-    if (!a.valid || !b.valid) continue;
-    const double limit = model_.collision_margin_m + a.braking_m + b.braking_m;
-    // Only while they approach: two arms stopped close together may still move apart. A change
-    // at rounding level (two arms standing, their setpoints re-solved) is not an approach.
-    constexpr double kApproach_m = 1e-12;
-    if (!(c.distance_m < limit) || !(c.distance_m < before - kApproach_m)) continue;
-    // Two arms whose setpoints stand still have nothing to stop (a pair first reported while
-    // both stand comes "from infinitely far").
-    const auto standing = [](const Robot& r) {
-      const rccl::TrajectoryGenerator& g = r.manipulator->generator();
-      return g.last_setpoint() == g.previous_setpoint();
-    };
-    if (standing(a) && standing(b)) continue;
+    const Threat& t = threats_[k];
+    Robot& a = *robots_[t.robot_a];
+    const RobotCapsules& ca = world_->robot(t.robot_a);
+    const Capsule& pa = ca.capsules()[t.capsule_a];
     try {
-      const auto r = fmt::format_to_n(
-          message_.data(), message_.size() - 1,
-          "collision stop: {} link {} and {} link {} would come {:.3f} m apart (margin {:.3f} m "
-          "+ braking {:.3f} m)",
-          a.name, c.link_a + 1, b.name, c.link_b + 1, c.distance_m, model_.collision_margin_m,
-          a.braking_m + b.braking_m);
-      *r.out = '\0';
+      std::array<char, 16> buf_a{}, buf_b{};
+      const std::string_view part_a = part_text(buf_a, ca.shape_name(pa), pa.link + 1);
+      fmt::format_to_n_result<char*> out{message_.data(), 0};
+      const std::size_t room = message_.size() - 1;
+      if (t.solid) {
+        out = fmt::format_to_n(message_.data(), room,
+                               "collision stop: {} {} would come {:.3f} m from object {} (margin "
+                               "{:.3f} m + braking {:.3f} m)",
+                               a.name, part_a, t.distance_m, model_.objects[t.b].name,
+                               model_.collision_margin_m, a.braking_m);
+      } else {
+        const Robot& b = *robots_[t.b];
+        const RobotCapsules& cb = world_->robot(t.b);
+        const Capsule& pb = cb.capsules()[t.capsule_b];
+        const std::string_view part_b = part_text(buf_b, cb.shape_name(pb), pb.link + 1);
+        out = fmt::format_to_n(
+            message_.data(), room,
+            "collision stop: {} {} and {} {} would come {:.3f} m apart (margin {:.3f} m + "
+            "braking {:.3f} m)",
+            a.name, part_a, b.name, part_b, t.distance_m, model_.collision_margin_m,
+            a.braking_m + b.braking_m);
+      }
+      *out.out = '\0';
     } catch (...) {  // fmt allocates nothing here; the stop matters more than its words
       message_[0] = '\0';
     }
     const std::string_view why(message_.data());
     a.manipulator->generator().request_stop(why);
-    b.manipulator->generator().request_stop(why);
+    if (!t.solid) robots_[t.b]->manipulator->generator().request_stop(why);
     collision_stops_.fetch_add(1, std::memory_order_acq_rel);
-  }
-  // Pairs reported last tick and not now are far again; only those are visited (not n^2).
-  for (const std::size_t pair : tracked_) {
-    if (seen_[pair] == 0) last[pair] = kInf;
-  }
-  tracked_.clear();
-  for (std::size_t k = 0; k < reported; ++k) {
-    const std::size_t pair = contacts_[k].robot_a * n + contacts_[k].robot_b;
-    tracked_.push_back(pair);
-    seen_[pair] = 0;
   }
 }
 

@@ -20,11 +20,15 @@
 // periods ahead), so a follower sampled at another rate does not lag.
 //
 // Safety between arms: after every tick the control task puts every robot's next setpoint
-// into a CollisionWorld (capsules per link, the cell's margin) and, when two robots' capsules
-// come closer than the margin plus both robots' braking allowance while approaching, asks both
-// generators to stop smoothly (TrajectoryGenerator::request_stop): their motions fail with a
-// message naming both robots and links (Manipulator::failures()). The braking allowance is a
-// bound on how far any point of a robot's links travels while it stops, see braking_m below.
+// into a CollisionWorld (the whole arm as capsules: links, joints, the cell file's shapes and
+// tool; the cell's objects as solids) and, when a part of a robot comes closer than the margin
+// plus the braking allowances to a part of another robot, or to an object, while approaching
+// it, asks the generators to stop smoothly (TrajectoryGenerator::request_stop): their motions
+// fail with a message naming the robots and parts (Manipulator::failures()). A setpoint that
+// moves every close pair apart goes on, so stopped arms can be separated. The braking allowance
+// is a bound on how far any point of a robot travels while it stops, see braking_m below. A
+// motion's tool may touch the objects its StartWhen::touch names (objects()); a robot's base
+// may rest on the object it is mounted on.
 //
 // A robot's fault ends its own control only: the others go on.
 #pragma once
@@ -181,9 +185,20 @@ class Cell {
                           const kin::JointVector& q1, const kin::JointVector& max_acceleration,
                           double period_s, const kin::JointVector& lever_m) noexcept;
   /// How far a point of the links joint j moves (or of their capsules) can be from its axis:
-  /// the lengths of links j.. (|a| + |d|, a prismatic d at its farther end), the tool's offset
-  /// and the largest capsule radius, m.
+  /// the lengths of links j.. (|a| + |d|, a prismatic d at its farther end), the tool's offset,
+  /// the reach of the shapes those links carry and the largest capsule radius, m.
   static kin::JointVector levers_m(const CellRobot& robot);
+  /// A robot's named capsules for the collision check: the cell file's shapes and, for a tool
+  /// without a shape in T6, a capsule from T6's origin to the tool's, the last link's radius.
+  static std::vector<ShapeSpec> shapes_of(const CellRobot& robot);
+
+  /// The objects (by name) a motion's tool may touch, for StartWhen::touch. Throws
+  /// std::invalid_argument naming the cell's objects for an unknown name, or for an object past the
+  /// 64th.
+  [[nodiscard]] std::uint64_t objects(const std::vector<std::string>& names) const;
+  /// What move() / dwell() take to let the motion's tool touch these objects:
+  /// `microbo.move(p, cell.touching({"board"}))`. Throws as objects().
+  [[nodiscard]] rccl::StartWhen touching(const std::vector<std::string>& names) const;
 
  private:
   struct Robot {
@@ -208,6 +223,7 @@ class Cell {
     bool valid = false;      ///< has a setpoint in the collision world
     bool fresh = false;      ///< `next` is this tick's, to be published at the tick's end
     double braking_m = 0.0;
+    std::uint64_t touch = 0;    ///< the objects its tool may touch now (CollisionWorld::set_touch)
     math::Vec3 velocity_back;   ///< the tool point's last backward difference, m/s
     ToolSample last;            ///< the last sample published
     ToolSample next;            ///< this tick's, computed after the robot's f2
@@ -224,6 +240,8 @@ class Cell {
   [[nodiscard]] static double braking_fast(const Robot& r, const kin::JointVector& q0,
                                            const kin::JointVector& q1) noexcept;
   void check_collisions() noexcept;
+  /// Throws CellFileError when a robot's ready pose lies inside an object it may not touch.
+  void check_clear_at_start() const;
   void publish_ledgers() noexcept;
 
   CellModel model_;
@@ -235,11 +253,7 @@ class Cell {
   std::vector<const rccl::TrajectoryGenerator*> generators_;
   std::vector<const rtc::Session*> sessions_;
   std::unique_ptr<CollisionWorld> world_;
-  std::vector<Contact> contacts_;        ///< the check's buffer, one per robot pair
-  std::vector<double> last_distance_m_;  ///< per robot pair (a * n + b), the last tick's
-  std::vector<std::uint8_t> seen_;       ///< per robot pair: reported this tick
-  std::vector<std::size_t> tracked_;     ///< pairs with a finite last distance
-  double widest_margin_m_ = 0.0;         ///< the world's margin with every robot at its top speeds
+  std::vector<Threat> threats_;  ///< the check's buffer: one per robot pair, robot and object
   std::array<char, rccl::kEventText> message_{};
   std::function<void(std::uint32_t)> observer_;
   std::atomic<std::uint64_t> collision_stops_{0};

@@ -173,6 +173,33 @@ void validate(const CellModel& cell, std::string_view origin) {
     }
     for (const double radius : r.link_radius_m)
       c.positive_length(radius, "link_radius_m", kMaxRadius_m);
+    if (r.shapes.size() > kMaxRobotShapes) {
+      c.fail(fmt::format("\"shapes\" has {}; at most {}", r.shapes.size(), kMaxRobotShapes));
+    }
+    std::set<std::string, std::less<>> shape_names;
+    for (std::size_t k = 0; k < r.shapes.size(); ++k) {
+      const RobotShape& s = r.shapes[k];
+      const Checker unnamed{fmt::format("{}: shape {}", c.where(), k + 1)};
+      unnamed.name(s.name);
+      const Checker sc{fmt::format("{}: shape {} \"{}\"", c.where(), k + 1, s.name)};
+      if (!shape_names.insert(s.name).second) {
+        sc.fail("\"name\" is another shape's already; shape names must be unique");
+      }
+      if (s.frame > r.model.dof()) {
+        sc.fail(
+            fmt::format("\"frame\" is {}; \"base\", 1 to {} or \"t6\"", s.frame, r.model.dof()));
+      }
+      for (const math::Vec3* v : {&s.from_m, &s.to_m}) {
+        for (int axis = 0; axis < 3; ++axis) {
+          if (!std::isfinite((*v)[axis]) || std::abs((*v)[axis]) > kMaxLength_m) {
+            sc.fail(fmt::format("\"from_m\" and \"to_m\" must be finite and within {:g} m",
+                                kMaxLength_m));
+          }
+        }
+      }
+      sc.positive_length(s.radius_m, "radius_m", kMaxRadius_m);
+      sc.text(s.note, "note");
+    }
     c.text(r.note, "note");
   }
 
@@ -202,6 +229,16 @@ void validate(const CellModel& cell, std::string_view origin) {
     }
     c.pose(o.pose, "pose");
     c.text(o.note, "note");
+  }
+  for (std::size_t i = 0; i < cell.robots.size(); ++i) {
+    const CellRobot& r = cell.robots[i];
+    if (!r.mounted_on.empty() && cell.find_object(r.mounted_on) == nullptr) {
+      std::string names;
+      for (const CellObject& o : cell.objects) names += (names.empty() ? "" : ", ") + o.name;
+      Checker{robot_where(origin, i, r.name)}.fail(
+          fmt::format("\"mounted_on\" names no object of the cell: \"{}\"; its objects: {}",
+                      r.mounted_on, names.empty() ? "none" : names));
+    }
   }
   for (std::size_t i = 0; i < cell.frames.size(); ++i) {
     const CellFrame& f = cell.frames[i];
@@ -254,6 +291,32 @@ math::Transform parse_pose(const json& j, const std::string& where) {
   return T;
 }
 
+/// {"name": "probe", "frame": "t6", "from_m": [0, 0, 0.06], "to_m": [0, 0, 0.16],
+/// "radius_m": 0.005}; "frame" is "base", "t6" or a link number 1 .. dof.
+RobotShape parse_shape(const json& j, const std::string& where, std::size_t dof) {
+  Reader r(j, where);
+  RobotShape s;
+  s.name = r.string("name");
+  const json& frame = r.get("frame");
+  if (frame.is_string() && frame.get<std::string>() == "base") {
+    s.frame = 0;
+  } else if (frame.is_string() && frame.get<std::string>() == "t6") {
+    s.frame = dof;
+  } else if (frame.is_number_integer()) {
+    s.frame = static_cast<std::size_t>(r.integer("frame", 1, static_cast<std::int64_t>(dof)));
+  } else {
+    r.fail(fmt::format("\"frame\" must be \"base\", \"t6\" or a link number 1 to {}", dof));
+  }
+  const auto from = r.numbers<3>("from_m", kMaxLength_m);
+  const auto to = r.numbers<3>("to_m", kMaxLength_m);
+  s.from_m = {from[0], from[1], from[2]};
+  s.to_m = {to[0], to[1], to[2]};
+  s.radius_m = r.number("radius_m", kMaxRadius_m);
+  s.note = r.string_or("note");
+  r.no_unknown_keys();
+  return s;
+}
+
 CellRobot parse_robot(const json& j, const std::string& where,
                       const std::filesystem::path& base_dir) {
   Reader r(j, where);
@@ -293,6 +356,17 @@ CellRobot parse_robot(const json& j, const std::string& where,
     r.fail("\"link_radius_m\" must be a number, or one number per joint");
   }
   if (r.has("tool")) robot.tool = parse_pose(r.get("tool"), where + ": \"tool\"");
+  if (r.has("shapes")) {
+    const json& shapes = r.get("shapes");
+    if (!shapes.is_array() || shapes.size() > kMaxRobotShapes) {
+      r.fail(fmt::format("\"shapes\" must be a list of at most {} shapes", kMaxRobotShapes));
+    }
+    for (std::size_t k = 0; k < shapes.size(); ++k) {
+      robot.shapes.push_back(
+          parse_shape(shapes[k], fmt::format("{}: shape {}", where, k + 1), robot.model.dof()));
+    }
+  }
+  if (r.has("mounted_on")) robot.mounted_on = r.string("mounted_on");
   robot.note = r.string_or("note");
   r.no_unknown_keys();
   return robot;

@@ -38,6 +38,20 @@ inline constexpr double kMaxRadius_m = 1.0;
 inline constexpr std::size_t kMaxName = 32;
 inline constexpr std::size_t kMaxText = 4096;  ///< bytes of a title, source or note
 
+/// A named capsule fixed in one of a robot's frames, for the collision check: what the DH chain
+/// does not say (a pedestal, a flange, a hand, the tool). Points in that frame, m.
+struct RobotShape {
+  std::string name;       ///< "pedestal", "flange", "probe"
+  std::size_t frame = 0;  ///< 0: the base frame; i: link i's frame; dof: T6
+  math::Vec3 from_m;
+  math::Vec3 to_m;
+  double radius_m = 0.0;
+  std::string note;
+};
+
+/// Shapes a robot may carry (cell/robot_capsules.hpp holds as many).
+inline constexpr std::size_t kMaxRobotShapes = 16;
+
 /// One robot of the cell.
 struct CellRobot {
   std::string name;  ///< its name in the cell ("puma"), unique among the robots
@@ -47,6 +61,11 @@ struct CellRobot {
   std::uint32_t period_multiple = 1;    ///< sampled every k-th tick of the cell's clock
   std::vector<double> link_radius_m;    ///< capsule radius per joint's link, m (dof() values)
   std::optional<math::Transform> tool;  ///< T6 <- tool frame, m; none: the tool is T6
+  /// Named capsules beyond the links; without one in T6, a robot with a tool gets a capsule
+  /// from T6's origin to the tool's of its last link's radius (cell::Cell).
+  std::vector<RobotShape> shapes;
+  /// The object the robot stands on (its mounting capsules may rest on it); empty: none.
+  std::string mounted_on;
   std::string note;
 };
 

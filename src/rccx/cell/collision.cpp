@@ -19,6 +19,13 @@ double along(const math::Vec3& v, int axis) noexcept {
 // and robots hovering near equal spreads must not pay it every sample.
 constexpr double kAxisHysteresis = 1.25;
 
+// A distance that shrinks by less than this (m) since the last check is not an approach: two
+// arms standing, their setpoints re-solved, change at rounding level.
+constexpr double kApproach_m = 1e-12;
+// Against a solid the distance comes from a search along the capsule's axis, exact to 1e-9 of
+// its length: a standing arm's re-solved setpoint may move the result by that much.
+constexpr double kApproachSolid_m = 1e-8;
+
 Contact make_contact(std::size_t a, const Capsule& ca, std::size_t b, const Capsule& cb,
                      const CapsuleDistance& d) noexcept {
   return {a, ca.link, b, cb.link, d.distance_m, d.on_a_m, d.on_b_m};
@@ -26,12 +33,18 @@ Contact make_contact(std::size_t a, const Capsule& ca, std::size_t b, const Caps
 
 }  // namespace
 
-CollisionWorld::CollisionWorld(std::vector<RobotCapsules> robots, double margin_m)
-    : robots_(std::move(robots)), margin_m_(margin_m) {
+CollisionWorld::CollisionWorld(std::vector<RobotCapsules> robots, double margin_m,
+                               std::vector<Solid> solids)
+    : robots_(std::move(robots)),
+      solids_(std::move(solids)),
+      allowance_m_(robots_.size(), 0.0),
+      touch_(robots_.size(), 0),
+      margin_m_(margin_m) {
   if (!std::isfinite(margin_m) || margin_m < 0.0) {
     throw std::invalid_argument("collision margin " + std::to_string(margin_m) +
                                 " m; it must be finite and not negative");
   }
+  margin_m_base_ = margin_m;
   if (robots_.size() > std::numeric_limits<std::uint32_t>::max()) {
     throw std::invalid_argument("too many robots for one collision world");
   }
@@ -56,6 +69,122 @@ CollisionWorld::CollisionWorld(std::vector<RobotCapsules> robots, double margin_
 
 bool CollisionWorld::set_configuration(std::size_t robot, const kin::JointVector& q) noexcept {
   return robot < robots_.size() && robots_[robot].update(q);
+}
+
+void CollisionWorld::set_allowance(std::size_t robot, double braking_m) noexcept {
+  if (robot < allowance_m_.size()) {
+    allowance_m_[robot] = std::isfinite(braking_m) && braking_m > 0.0 ? braking_m : 0.0;
+  }
+}
+
+void CollisionWorld::set_touch(std::size_t robot, std::uint64_t solids) noexcept {
+  if (robot < touch_.size()) touch_[robot] = solids;
+}
+
+bool CollisionWorld::exempt(std::size_t r, const Capsule& c, std::size_t s) const noexcept {
+  if (c.mounting && robots_[r].mounted_on() == static_cast<int>(s)) return true;
+  return c.tool && s < 64 && (touch_[r] >> s & 1U) != 0;
+}
+
+bool CollisionWorld::robot_threat(std::size_t a, std::size_t b, Threat& out) noexcept {
+  const RobotCapsules& ra = robots_[a];
+  const RobotCapsules& rb = robots_[b];
+  // Neither moved since the last check: nothing approaches.
+  if (!ra.moved() && !rb.moved()) return false;
+  const double limit = margin_m_base_ + allowance_m_[a] + allowance_m_[b];
+  const std::span<const Capsule> ca_now = ra.capsules(), cb_now = rb.capsules();
+  const std::span<const Capsule> ca_was = ra.before(), cb_was = rb.before();
+  bool found = false;
+  for (std::size_t i = 0; i < ca_now.size(); ++i) {
+    const Capsule& ca = ca_now[i];
+    if (!overlap(ca.bounds, rb.bounds(), limit)) continue;
+    for (std::size_t k = 0; k < cb_now.size(); ++k) {
+      const Capsule& cb = cb_now[k];
+      if (!overlap(ca.bounds, cb.bounds, limit)) continue;
+      ++stats_.capsule_pairs;
+      const double d = capsule_distance(ca, cb).distance_m;
+      if (!(d < limit) || (found && d >= out.distance_m)) continue;
+      const double was = capsule_distance(ca_was[i], cb_was[k]).distance_m;
+      if (!(d < was - kApproach_m)) continue;  // moving apart, or standing
+      out = {a, i, false, b, k, d, was, limit};
+      found = true;
+    }
+  }
+  return found;
+}
+
+bool CollisionWorld::solid_threat(std::size_t r, std::size_t s, Threat& out) noexcept {
+  const RobotCapsules& robot = robots_[r];
+  const Solid& solid = solids_[s];
+  const double limit = margin_m_base_ + allowance_m_[r];
+  if (!overlap(robot.bounds(), solid.bounds, limit)) return false;
+  const std::span<const Capsule> now = robot.capsules(), was = robot.before();
+  bool found = false;
+  for (std::size_t i = 0; i < now.size(); ++i) {
+    const Capsule& c = now[i];
+    if (!overlap(c.bounds, solid.bounds, limit) || exempt(r, c, s)) continue;
+    ++stats_.solid_pairs;
+    const double d = capsule_solid_distance(c, solid).distance_m;
+    if (!(d < limit) || (found && d >= out.distance_m)) continue;
+    const double before = capsule_solid_distance(was[i], solid).distance_m;
+    if (!(d < before - kApproachSolid_m)) continue;
+    out = {r, i, true, s, 0, d, before, limit};
+    found = true;
+  }
+  return found;
+}
+
+std::size_t CollisionWorld::threats(std::span<Threat> out) noexcept {
+  // The broad phase passes every pair whose boxes come within the largest limit of this call.
+  double widest = 0.0, second = 0.0;
+  for (const double a : allowance_m_) {
+    if (a > widest) {
+      second = widest;
+      widest = a;
+    } else if (a > second) {
+      second = a;
+    }
+  }
+  const double saved = margin_m_;
+  margin_m_ = margin_m_base_ + widest + second;
+  std::size_t count = 0;
+  Threat t;
+  sweep([&](std::size_t a, std::size_t b) {
+    if (!robot_threat(a, b, t)) return;
+    if (count < out.size()) out[count] = t;
+    ++count;
+  });
+  for (std::size_t r = 0; r < robots_.size(); ++r) {
+    if (!robots_[r].moved()) continue;  // the solids stand: only a moving robot approaches
+    for (std::size_t s = 0; s < solids_.size(); ++s) {
+      if (!solid_threat(r, s, t)) continue;
+      if (count < out.size()) out[count] = t;
+      ++count;
+    }
+  }
+  margin_m_ = saved;
+  for (RobotCapsules& r : robots_) r.settle();
+  return count;
+}
+
+SolidContact CollisionWorld::min_solid_distance(std::size_t robot, std::size_t solid,
+                                                bool exemptions) const noexcept {
+  SolidContact best;
+  best.distance_m = std::numeric_limits<double>::infinity();
+  if (robot >= robots_.size() || solid >= solids_.size()) return best;
+  best.robot = robot;
+  best.solid = solid;
+  const std::span<const Capsule> caps = robots_[robot].capsules();
+  for (std::size_t i = 0; i < caps.size(); ++i) {
+    if (exemptions && exempt(robot, caps[i], solid)) continue;
+    const SolidDistance d = capsule_solid_distance(caps[i], solids_[solid]);
+    if (d.distance_m < best.distance_m) {
+      best.capsule = i;
+      best.distance_m = d.distance_m;
+      best.point_m = d.on_axis_m;
+    }
+  }
+  return best;
 }
 
 bool CollisionWorld::set_margin(double margin_m) noexcept {

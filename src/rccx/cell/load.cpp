@@ -33,17 +33,18 @@ CellModel grid_cell(std::size_t count, std::string_view robot, double spacing_m,
   return m;
 }
 
-void start_circles(Cell& cell) {
+void start_circles(Cell& cell, const math::Vec3& centre_m) {
   using namespace math::literals;
   constexpr double kRadius_m = 0.020;
   constexpr double kTurn_s = 5.0;
   cell.start();
   const auto t6 = rccl::t6();
-  // The wrist 450 mm out and 150 mm below the shoulder, pointing down and out (example 05's
-  // reach of the PUMA 560); the circle in the base's x-y plane around it.
+  // The wrist at centre_m (by default 450 mm out and 150 mm below the shoulder, example 05's
+  // reach of the PUMA 560), pointing down and out; the circle in the base's x-y plane around it.
   const math::Rot3 pointing = math::Rot3::rot_y(-45_deg) * math::Rot3::rot_x(180_deg);
   const auto grasp = rccl::constant("GRASP", {pointing, {}});
-  const auto over = rccl::constant("OVER", math::Transform::translation(450_mm, -50_mm, -150_mm));
+  const auto over =
+      rccl::constant("OVER", math::Transform::translation(centre_m.x, centre_m.y, centre_m.z));
   const auto circle = rccl::functional("CIRCLE", [](const rccl::SampleContext& c) {
     const double a = 2.0 * math::kPi * c.t_s / kTurn_s;  // runs in the loop: no allocation
     return math::Transform::translation(kRadius_m * std::cos(a), kRadius_m * std::sin(a), 0.0);

@@ -1,5 +1,7 @@
 #include "rccx/cell/robot_capsules.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -13,10 +15,14 @@ namespace {
 // gets one capsule, not a second of zero length.
 constexpr double kZeroLength_m = 1e-9;
 
+bool finite(const math::Vec3& v) {
+  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+
 }  // namespace
 
 RobotCapsules::RobotCapsules(const kin::RobotModel& model, std::span<const double> link_radius_m,
-                             const math::Transform& base)
+                             const math::Transform& base, std::span<const ShapeSpec> shapes)
     : base_(base) {
   const std::size_t dof = model.dof();
   if (dof == 0 || dof > kin::kMaxJoints) {
@@ -35,23 +41,65 @@ RobotCapsules::RobotCapsules(const kin::RobotModel& model, std::span<const doubl
                                   " m; radii must be finite and not negative");
     }
   }
+  if (shapes.size() > kMaxShapes) {
+    throw std::invalid_argument(
+        fmt::format("robot {}: {} shapes; at most {}", model.name, shapes.size(), kMaxShapes));
+  }
   chain_ = kin::DhChain(model);
   q_ = kin::JointVector(dof);
+  const auto radius = [&](std::size_t i) {
+    return link_radius_m.size() == 1 ? link_radius_m[0] : link_radius_m[i];
+  };
+  // Frames 0 .. k have their origins at the base's in every configuration while every link
+  // before them is a pure rotation: pieces that start there reach the base origin always.
+  std::size_t origin_frames = 0;  // frames 0 .. origin_frames sit at the base origin
   for (std::size_t i = 0; i < dof; ++i) {
-    radius_m_[i] = link_radius_m.size() == 1 ? link_radius_m[0] : link_radius_m[i];
     const kin::DhChain::Link& l = chain_.links[i];
-    const auto link = static_cast<std::uint8_t>(i);
-    if (l.prismatic || std::abs(l.d_m) > kZeroLength_m) pieces_[count_++] = {link, true};
-    if (std::abs(l.a_m) > kZeroLength_m) pieces_[count_++] = {link, false};
+    const auto add = [&](std::size_t frame, bool prismatic, const math::Vec3& from,
+                         const math::Vec3& to) {
+      Capsule& c = capsules_[count_];
+      c.link = static_cast<std::uint8_t>(i);
+      c.radius_m = radius(i);
+      c.mounting = frame <= origin_frames && from.norm() <= kZeroLength_m;
+      pieces_[count_++] = {static_cast<std::uint8_t>(frame), prismatic, from, to};
+    };
+    const bool d_part = l.prismatic || std::abs(l.d_m) > kZeroLength_m;
+    const bool a_part = std::abs(l.a_m) > kZeroLength_m;
+    if (!d_part && !a_part && origin_frames == i) origin_frames = i + 1;
+    // The d part, in frame i-1: from its origin along its z.
+    if (d_part) add(i, l.prismatic, {0, 0, 0}, {0, 0, l.d_m});
+    // The a part, in frame i: from -a along its x to its origin.
+    if (a_part) add(i + 1, false, {-l.a_m, 0, 0}, {0, 0, 0});
+    // Neither: the joint as a sphere at frame i's origin (where frame i-1's is too).
+    if (!d_part && !a_part) add(i + 1, false, {0, 0, 0}, {0, 0, 0});
   }
-  for (std::size_t k = 0; k < count_; ++k) {
-    capsules_[k].link = pieces_[k].link;
-    capsules_[k].radius_m = radius_m_[pieces_[k].link];
+  for (const ShapeSpec& s : shapes) {
+    if (s.frame > dof) {
+      throw std::invalid_argument(
+          fmt::format("robot {}: shape \"{}\" is in frame {}; 0 (the base) to {} (T6)", model.name,
+                      s.name, s.frame, dof));
+    }
+    if (!finite(s.from_m) || !finite(s.to_m) || !std::isfinite(s.radius_m) || s.radius_m < 0.0) {
+      throw std::invalid_argument(fmt::format(
+          "robot {}: shape \"{}\": its points and radius must be finite, the radius not negative",
+          model.name, s.name));
+    }
+    Capsule& c = capsules_[count_];
+    c.link = static_cast<std::uint8_t>(s.frame == 0 ? 0 : s.frame - 1);
+    c.radius_m = s.radius_m;
+    c.shape = static_cast<std::int8_t>(shape_names_.size());
+    c.tool = s.frame == dof;
+    // A base shape never moves: it rests on what the robot stands on.
+    c.mounting = s.frame == 0 || (s.frame <= origin_frames && (s.from_m.norm() <= kZeroLength_m ||
+                                                               s.to_m.norm() <= kZeroLength_m));
+    pieces_[count_++] = {static_cast<std::uint8_t>(s.frame), false, s.from_m, s.to_m};
+    shape_names_.push_back(s.name);
   }
   const kin::JointVector ready = model.ready();
   if (!update(ready)) {
     throw std::invalid_argument("robot " + model.name + ": the ready pose is not finite");
   }
+  settle();
 }
 
 bool RobotCapsules::update(const kin::JointVector& q) noexcept {
@@ -59,23 +107,24 @@ bool RobotCapsules::update(const kin::JointVector& q) noexcept {
   for (const double v : q) {
     if (!std::isfinite(v)) return false;
   }
+  if (!moved_) {
+    std::copy_n(capsules_.begin(), count_, before_.begin());
+    moved_ = true;
+  }
   auto& frames = frames_;
   kin::link_frames(chain_, q, frames, base_);
   bool first = true;
   for (std::size_t k = 0; k < count_; ++k) {
-    const std::size_t i = pieces_[k].link;
+    const Piece& piece = pieces_[k];
     Capsule& c = capsules_[k];
-    const math::Transform& end = frames[i];
-    if (pieces_[k].along_z) {
-      // From frame i-1's origin, d_i along its z.
-      const math::Transform& start = i == 0 ? base_ : frames[i - 1];
-      const double d = chain_.links[i].d_m + (chain_.links[i].prismatic ? q[i] : 0.0);
-      c.p0_m = start.p;
-      c.p1_m = start.p + start.R.a * d;
+    const math::Transform& frame = piece.frame == 0 ? base_ : frames[piece.frame - 1];
+    c.p0_m = frame * piece.from_m;
+    if (piece.prismatic) {
+      // The d part of joint `frame` + 1 (0-based: frame), its length d + q.
+      const std::size_t j = piece.frame;
+      c.p1_m = frame.p + frame.R.a * (chain_.links[j].d_m + q[j]);
     } else {
-      // To frame i's origin, a_i along its x.
-      c.p1_m = end.p;
-      c.p0_m = end.p - end.R.n * chain_.links[i].a_m;
+      c.p1_m = frame * piece.to_m;
     }
     c.bounds = bounds_of(c.p0_m, c.p1_m, c.radius_m);
     if (first) {
@@ -90,11 +139,16 @@ bool RobotCapsules::update(const kin::JointVector& q) noexcept {
                       std::max(bounds_.hi_m.z, c.bounds.hi_m.z)};
     }
   }
-  // A robot without capsules (every DH length zero) is a point at its base.
+  // Every robot has a capsule per joint now; kept for a robot of no joints' worth.
   if (first) bounds_ = {base_.p, base_.p};
   // Element by element: a JointVector assignment compiles to a slow block copy here.
   std::copy(q.begin(), q.end(), q_.begin());
   return true;
+}
+
+std::string part_name(const RobotCapsules& robot, const Capsule& c) {
+  if (c.shape >= 0) return std::string(robot.shape_name(c));
+  return "link " + std::to_string(c.link + 1);
 }
 
 }  // namespace rccx::cell

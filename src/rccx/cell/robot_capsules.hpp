@@ -1,15 +1,26 @@
-// One robot's links as capsules in the world, for the collision check between arms.
+// One robot as capsules in the world, the whole arm: its links, its joints, its base, its hand
+// and its tool, for the collision check between arms and against the cell's objects.
 //
 // Link i of a DH robot runs from the origin of frame i-1 to the origin of frame i: first d_i
 // along z_(i-1), then a_i along x_i (standard DH). Each non-zero part is one capsule (a
-// prismatic joint's d part is always one, since its length changes with q). What the pieces
-// are is worked out once at construction (which may allocate and throw); update(q) then only
-// computes the link frames and the world-space segments and boxes: noexcept, no allocation.
+// prismatic joint's d part is always one, since its length changes with q). A link with
+// neither (a wrist joint: the PUMA's links 5 and 6, the Microbo's 1, 4, 5 and 6) is a sphere
+// at its frame's origin, so that no joint is left out. Radii: one per link, from the cell file.
+// Named shapes (ShapeSpec) add what the DH chain does not say: a pedestal in the base frame, a
+// flange, a hand and the tool in T6.
+//
+// What the pieces are is worked out once at construction (which may allocate and throw);
+// update(q) then only computes the link frames and the world-space segments and boxes:
+// noexcept, no allocation. The capsules before the last update are kept (before()), so that a
+// check can tell two parts approaching from two parts moving apart.
 #pragma once
 
 #include <array>
 #include <cstddef>
 #include <span>
+#include <string>
+#include <string_view>
+#include <vector>
 
 #include "rccx/cell/capsule.hpp"
 #include "rccx/kinematics/joint_vector.hpp"
@@ -19,24 +30,47 @@
 
 namespace rccx::cell {
 
+/// A named capsule fixed in one of the robot's frames: 0 the base frame, i = 1 .. dof link i's
+/// frame (dof: T6, where the flange, the hand and the tool are). Points in that frame, m.
+struct ShapeSpec {
+  std::string name;  ///< "pedestal", "flange", "probe": what a stop message calls it
+  std::size_t frame = 0;
+  math::Vec3 from_m;
+  math::Vec3 to_m;
+  double radius_m = 0.0;
+};
+
 class RobotCapsules {
  public:
-  /// At most two capsules per joint (the d part and the a part).
-  static constexpr std::size_t kMaxCapsules = 2 * kin::kMaxJoints;
+  /// Two capsules per joint (the d part and the a part, or the joint's sphere) and the shapes.
+  static constexpr std::size_t kMaxShapes = 16;
+  static constexpr std::size_t kMaxCapsules = 2 * kin::kMaxJoints + kMaxShapes;
 
   /// `link_radius_m` holds one radius (m) for every link or one per joint; `base` places the
-  /// robot's frame 0 in the world. Throws std::invalid_argument for a model of more than
-  /// kin::kMaxJoints joints or none, a wrong number of radii, or a radius that is negative or
-  /// not finite. The capsules start at the model's ready pose.
+  /// robot's frame 0 in the world; `shapes` adds named capsules (at most kMaxShapes). Throws
+  /// std::invalid_argument for a model of more than kin::kMaxJoints joints or none, a wrong
+  /// number of radii, a radius that is negative or not finite, or a bad shape (a frame past
+  /// T6, a point or radius not finite). The capsules start at the model's ready pose.
   RobotCapsules(const kin::RobotModel& model, std::span<const double> link_radius_m,
-                const math::Transform& base = math::Transform::identity());
+                const math::Transform& base = math::Transform::identity(),
+                std::span<const ShapeSpec> shapes = {});
 
   /// Moves the capsules to joint values q (rad / m). False, and nothing changed, when q has the
-  /// wrong size or a value that is not finite.
+  /// wrong size or a value that is not finite. The capsules as they were go to before() unless
+  /// an update since the last settle() put them there already.
   bool update(const kin::JointVector& q) noexcept;
+  /// The check has compared before() with capsules(): from now on before() is capsules()
+  /// until the next update.
+  void settle() noexcept { moved_ = false; }
+  /// True when update() has moved the capsules since the last settle().
+  [[nodiscard]] bool moved() const noexcept { return moved_; }
 
   [[nodiscard]] std::span<const Capsule> capsules() const noexcept {
     return {capsules_.data(), count_};
+  }
+  /// The capsules at the last settle() (the same as capsules() when nothing moved since).
+  [[nodiscard]] std::span<const Capsule> before() const noexcept {
+    return moved_ ? std::span<const Capsule>{before_.data(), count_} : capsules();
   }
   /// The box around every capsule, m.
   [[nodiscard]] const Aabb& bounds() const noexcept { return bounds_; }
@@ -50,24 +84,41 @@ class RobotCapsules {
   [[nodiscard]] const math::Transform& link_frame(std::size_t i) const noexcept {
     return frames_[i];
   }
+  /// The name of a capsule's shape ("probe"), or "" for a link's piece.
+  [[nodiscard]] std::string_view shape_name(const Capsule& c) const noexcept {
+    return c.shape < 0 ? std::string_view{} : std::string_view{shape_names_[c.shape]};
+  }
+  /// The object index (of the cell's objects) the robot stands on, whose contact with the
+  /// robot's mounting capsules is not a collision; -1: none.
+  [[nodiscard]] int mounted_on() const noexcept { return mounted_on_; }
+  void set_mounted_on(int object) noexcept { mounted_on_ = object; }
 
  private:
-  /// Which part of which link a capsule covers.
+  /// Where a capsule is: a segment in frame `frame` (0 base, i link i), whose far end moves
+  /// along z by the joint value when `prismatic` (the d part of a prismatic joint).
   struct Piece {
-    std::uint8_t link = 0;
-    bool along_z = false;  ///< the d part (along z_(i-1)); else the a part (along x_i)
+    std::uint8_t frame = 0;
+    bool prismatic = false;
+    math::Vec3 from_m;
+    math::Vec3 to_m;
   };
 
   kin::DhChain chain_;
   math::Transform base_;
-  std::array<double, kin::kMaxJoints> radius_m_{};
   std::array<Piece, kMaxCapsules> pieces_{};
   std::array<Capsule, kMaxCapsules> capsules_{};
+  std::array<Capsule, kMaxCapsules> before_{};
+  std::vector<std::string> shape_names_;
   /// update()'s link frames, kept here so that each call does not initialise new ones.
   std::array<math::Transform, kin::kMaxJoints> frames_{};
   std::size_t count_ = 0;
   Aabb bounds_;
   kin::JointVector q_;
+  bool moved_ = false;
+  int mounted_on_ = -1;
 };
+
+/// A capsule's name in messages: "link 4", or its shape's name.
+std::string part_name(const RobotCapsules& robot, const Capsule& c);
 
 }  // namespace rccx::cell

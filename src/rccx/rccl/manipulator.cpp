@@ -252,6 +252,7 @@ Motion Manipulator::submit(MotionRequest r, const PositionPtr& keep, const Start
   if (zero_gravity_) throw MotionError("zero gravity is on: set_zero_gravity(false) first");
   r.id = next_id_;
   r.settings = settings_;
+  r.settings.may_touch = when.touch;
   if (configuration >= 0) r.settings.configuration = configuration;
   if (when.after.size() > StartWhen::kMaxGates) {
     throw MotionError(

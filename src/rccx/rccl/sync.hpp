@@ -163,6 +163,9 @@ struct StartWhen {
   std::vector<EventGate> after;
   std::shared_ptr<Rendezvous> together;
   std::size_t slot = 0;  ///< this motion's place in `together`
+  /// The cell's objects this motion's tool may touch (cell::Cell::objects): nothing else may
+  /// be touched. MotionSettings::may_touch.
+  std::uint64_t touch = 0;
 };
 
 }  // namespace rccx::rccl

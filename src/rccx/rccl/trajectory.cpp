@@ -1185,6 +1185,7 @@ void TrajectoryGenerator::reset(const JointVector& q, double t_s) noexcept {
   halt_ = Halt{};
   halt_requested_.store(false);
   stop_requested_ = false;
+  last_motion_ = 0;
   rest_at(q);
   last_q_ = prev_q_ = q;
   last_t_ = t_s - options_.period_s;
@@ -1323,8 +1324,8 @@ std::uint64_t TrajectoryGenerator::step(const SampleContext& ctx, const JointVec
   prev_q_ = last_q_;
   last_q_ = q;
   last_t_ = t;
-  if (tr_.active && tr_.to_next) return next_.id;
-  return cur_.id;
+  last_motion_ = tr_.active && tr_.to_next ? next_.id : cur_.id;
+  return last_motion_;
 }
 
 void TrajectoryGenerator::record(const SampleContext& ctx, const JointVector& q,

@@ -82,6 +82,10 @@ struct MotionSettings {
   /// The motion's tool product TOOL (T6 to the tool frame F, m): the frame the guard's and
   /// the compliance's axes are in. Set by Manipulator::move from the position.
   math::Transform tool;
+  /// The cell's objects (bit i: object i) the tool may touch during this motion (a probe, a
+  /// grasp, a guarded descent): the cell's collision check lets the tool's capsules come within
+  /// the margin of them. From StartWhen::touch.
+  std::uint64_t may_touch = 0;
 };
 
 enum class RequestKind : std::uint8_t { move, dwell };
@@ -208,6 +212,8 @@ class TrajectoryGenerator {
   [[nodiscard]] bool at_rest() const noexcept;
   /// The settings of motion `id` while it runs (the id step() returned), else null.
   [[nodiscard]] const MotionSettings* running_settings(std::uint64_t id) const noexcept;
+  /// The id the last step() returned: the motion the last setpoint belongs to (0 at rest).
+  [[nodiscard]] std::uint64_t last_motion() const noexcept { return last_motion_; }
   [[nodiscard]] const kin::Kinematics& kinematics() const noexcept { return kin_; }
   [[nodiscard]] const GeneratorOptions& options() const noexcept { return options_; }
 
@@ -377,7 +383,8 @@ class TrajectoryGenerator {
   boost::lockfree::spsc_queue<MotionEvent, boost::lockfree::capacity<4 * kQueueCapacity>> events_;
   std::atomic<bool> halt_requested_{false};
   std::atomic<bool> next_requested_{false};
-  bool stop_requested_ = false;  ///< request_stop(): same thread as step()
+  bool stop_requested_ = false;    ///< request_stop(): same thread as step()
+  std::uint64_t last_motion_ = 0;  ///< what step() returned last
   Text stop_text_{};
   std::array<SegmentReport, kReports> reports_{};
 

@@ -2,12 +2,14 @@
 
 #include <nlohmann/json.hpp>
 
+#include "rccx/cell/cell.hpp"
+
 namespace rccx::view {
 
 Scene Scene::of_robot(const kin::RobotModel& model) {
   Scene s;
   s.title = model.title.empty() ? model.name : model.title;
-  s.robots.push_back({model.name, model, math::Transform::identity(), std::nullopt, {}});
+  s.robots.push_back({model.name, model, math::Transform::identity(), std::nullopt, {}, {}});
   return s;
 }
 
@@ -15,7 +17,11 @@ Scene Scene::of_cell(const cell::CellModel& model) {
   Scene s;
   s.title = model.title.empty() ? model.name : model.title;
   for (const cell::CellRobot& r : model.robots) {
-    s.robots.push_back({r.name, r.model, r.base, r.tool, r.link_radius_m});
+    std::vector<cell::RobotShape> shapes;
+    for (const cell::ShapeSpec& k : cell::Cell::shapes_of(r)) {
+      shapes.push_back({k.name, k.frame, k.from_m, k.to_m, k.radius_m, ""});
+    }
+    s.robots.push_back({r.name, r.model, r.base, r.tool, r.link_radius_m, std::move(shapes)});
   }
   s.objects = model.objects;
   for (const cell::CellFrame& f : model.frames) s.frames.push_back({f.name, f.pose, f.note});
@@ -34,6 +40,22 @@ std::string Scene::robot_list() const {
   for (const SceneRobot& r : robots) out += (out.empty() ? "" : ", ") + r.name;
   return out;
 }
+
+namespace {
+
+nlohmann::json shapes_json(const std::vector<cell::RobotShape>& shapes) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const cell::RobotShape& k : shapes) {
+    out.push_back({{"name", k.name},
+                   {"frame", k.frame},
+                   {"from", {k.from_m.x, k.from_m.y, k.from_m.z}},
+                   {"to", {k.to_m.x, k.to_m.y, k.to_m.z}},
+                   {"radius", k.radius_m}});
+  }
+  return out;
+}
+
+}  // namespace
 
 nlohmann::json to_json(const math::Transform& t) {
   return nlohmann::json::array({t.R.n.x, t.R.n.y, t.R.n.z, 0.0, t.R.o.x, t.R.o.y, t.R.o.z, 0.0,
@@ -64,6 +86,7 @@ nlohmann::json to_json(const Scene& scene, int only) {
                       {"base", to_json(r.base)},
                       {"tool", r.tool ? to_json(*r.tool) : nlohmann::json(nullptr)},
                       {"radii", r.link_radius_m},
+                      {"shapes", shapes_json(r.shapes)},
                       {"joints", joints}});
   }
   nlohmann::json objects = nlohmann::json::array();

@@ -21,6 +21,9 @@ struct SceneRobot {
   math::Transform base;                 ///< world <- base, m
   std::optional<math::Transform> tool;  ///< T6 <- tool
   std::vector<double> link_radius_m;    ///< the cell's capsules; empty: none
+  /// The collision model's named capsules beyond the links (cell::Cell::shapes_of): a
+  /// pedestal, a flange, a hand, the tool.
+  std::vector<cell::RobotShape> shapes;
 };
 
 /// A named frame to draw (a cell frame, the goal of a position equation).
