@@ -192,6 +192,10 @@ rc::PositionPtr build_position(const PositionBox& p, const math::Transform& extr
 void refresh() noexcept;
 /// Prints the motions of the one-robot session that failed since the last call.
 void report_failures();
+/// POS.code of each motion's position from the arm's events since the last call: 0 ended,
+/// RCCL_NEXTMOVE / RCCL_ONF ended early by nextmove, RTC_E_MOTION failed or cancelled.
+void show_motion_codes(rc::Manipulator& arm,
+                       const std::map<std::uint64_t, PositionBox*>& motion_boxes);
 /// The robot for rccl_open / RCCX_ROBOT.
 kin::RobotModel choose_robot(const char* robot);
 /// waitfor() with a cell: one tick of the cell's clock.

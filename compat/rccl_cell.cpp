@@ -23,21 +23,7 @@ namespace {
 bool cell_report(rccl_manip& m) {
   // POS.code of each motion's position, as move() sets it for one robot: 0 when it ended,
   // RCCL_NEXTMOVE / RCCL_ONF ended early, RTC_E_MOTION failed or cancelled (a collision stop).
-  for (const rc::MotionEvent& e : m.arm->take_events()) {
-    const auto it = m.motion_boxes.find(e.id);
-    if (it == m.motion_boxes.end()) continue;
-    if (e.kind == rc::EventKind::ended) {
-      int code = 0;
-      if (e.message() == rc::kNextmoveText) {
-        code = m.arm->contact(rc::Motion{e.id}) ? RCCL_ONF : RCCL_NEXTMOVE;
-      }
-      it->second->shown->code = code;
-      m.motion_boxes.erase(it);
-    } else if (e.kind == rc::EventKind::failed || e.kind == rc::EventKind::cancelled) {
-      it->second->shown->code = RTC_E_MOTION;
-      m.motion_boxes.erase(it);
-    }
-  }
+  show_motion_codes(*m.arm, m.motion_boxes);
   const std::vector<rc::MotionEvent>& f = m.arm->failures();
   std::size_t cancelled = 0;
   for (; m.failures_seen < f.size(); ++m.failures_seen) {

@@ -388,22 +388,27 @@ void loop_nextmove() noexcept {
   act_on_nextmove(state());
 }
 
-void report_failures() {
-  State& s = state();
-  // Ended events of nextmove, and failures, set POS.code of the motion's position.
-  for (const rc::MotionEvent& e : s.arm->take_events()) {
-    const auto it = s.motion_boxes.find(e.id);
-    if (it == s.motion_boxes.end()) continue;
+void show_motion_codes(rc::Manipulator& arm,
+                       const std::map<std::uint64_t, PositionBox*>& motion_boxes) {
+  for (const rc::MotionEvent& e : arm.take_events()) {
+    const auto it = motion_boxes.find(e.id);
+    if (it == motion_boxes.end()) continue;
     if (e.kind == rc::EventKind::ended) {
       int code = 0;
       if (e.message() == rc::kNextmoveText) {
-        code = s.arm->contact(rc::Motion{e.id}) ? RCCL_ONF : RCCL_NEXTMOVE;
+        code = arm.contact(rc::Motion{e.id}) ? RCCL_ONF : RCCL_NEXTMOVE;
       }
       it->second->shown->code = code;
     } else if (e.kind == rc::EventKind::failed || e.kind == rc::EventKind::cancelled) {
       it->second->shown->code = RTC_E_MOTION;
     }
   }
+}
+
+void report_failures() {
+  State& s = state();
+  // Ended events of nextmove, and failures, set POS.code of the motion's position.
+  show_motion_codes(*s.arm, s.motion_boxes);
   const std::vector<rc::MotionEvent>& f = s.arm->failures();
   std::size_t cancelled = 0;
   for (; s.failures_seen < f.size(); ++s.failures_seen) {

@@ -2,6 +2,8 @@
 // robots, a robot's tool point, its failures as text.
 #pragma once
 
+#include <algorithm>
+#include <memory>
 #include <string>
 
 #include "rccx/cell/cell.hpp"
@@ -34,6 +36,17 @@ inline math::Vec3 tool_point(cell::Cell& c, const std::string& robot, const kin:
 
 /// Where the board is: 50 mm above its top face.
 inline const math::Vec3 kAbove{0.0, 0.0, 0.1516};
+
+/// The closest the two first robots' parts have come, m, updated after every tick by the cell's
+/// cycle observer (before start()). Shared, so that it outlives the ticks the cell's destructor
+/// may still run.
+inline std::shared_ptr<double> watch_closest(cell::Cell& c) {
+  auto closest = std::make_shared<double>(1e9);
+  c.set_cycle_observer([&c, closest](std::uint32_t) {
+    *closest = std::min(*closest, c.collision_world().min_distance(0, 1).distance_m);
+  });
+  return closest;
+}
 
 /// Every failure message of a robot, for assertion output.
 inline std::string failures_of(rccl::Manipulator& m) {

@@ -41,10 +41,8 @@ TEST(CellRuntime, BuildsEveryRobotOfTheCellFile) {
 
 TEST(CellRuntime, BothRobotsMoveAtOnceInJointAndCartesianMode) {
   const auto c = cell::Cell::load(kCvarl);
-  double closest_m = 1e9;
-  c->set_cycle_observer([&](std::uint32_t) {
-    closest_m = std::min(closest_m, c->collision_world().min_distance(0, 1).distance_m);
-  });
+  const std::shared_ptr<double> closest = watch_closest(*c);
+  const double& closest_m = *closest;
   c->start();
   rccl::Manipulator& puma = c->robot("puma");
   rccl::Manipulator& microbo = c->robot("microbo");
@@ -174,10 +172,8 @@ TEST(CellRuntime, TheMicroboFollowsAFrameThePumaMoves) {
 TEST(CellRuntime, TwoArmsDrivenTowardsEachOtherStopOutsideTheMargin) {
   const auto c = cell::Cell::load(kCvarl);
   const double margin_m = c->model().collision_margin_m;
-  double closest_m = 1e9;
-  c->set_cycle_observer([&](std::uint32_t) {
-    closest_m = std::min(closest_m, c->collision_world().min_distance(0, 1).distance_m);
-  });
+  const std::shared_ptr<double> closest = watch_closest(*c);
+  const double& closest_m = *closest;
   c->start();
   rccl::Manipulator& puma = c->robot("puma");
   rccl::Manipulator& microbo = c->robot("microbo");
@@ -237,10 +233,8 @@ TEST(CellRuntime, TwoArmsStanding40mmApartAreSeparatedWithNoStop) {
   for (int k = 0; k < 40; ++k) ((gap((lo + hi) / 2) > 0.04) ? lo : hi) = (lo + hi) / 2;
   ASSERT_NEAR(gap(lo), 0.04, 1e-4);
   const auto c = std::make_unique<cell::Cell>(model);
-  double closest_m = 1e9;
-  c->set_cycle_observer([&](std::uint32_t) {
-    closest_m = std::min(closest_m, c->collision_world().min_distance(0, 1).distance_m);
-  });
+  const std::shared_ptr<double> closest = watch_closest(*c);
+  const double& closest_m = *closest;
   c->start();
   rccl::Manipulator& puma = c->robot("puma");
   rccl::Manipulator& microbo = c->robot("microbo");
