@@ -229,11 +229,18 @@ try {
   await cpage.waitForFunction((ns) => ns.every((n, i) => window.rccxView.frameNames.includes(`${i}:${n}_P1`)),
     names, { timeout: 30000 });
   await cpage.waitForFunction(() => window.rccxView.robots.every((r) => r.goal), null, { timeout: 30000 });
+  // Each robot's running goal marked: at the sample a new motion starts its goal's label may
+  // come a frame later (the goal is drawn when the move is queued), so wait for a frame where
+  // every robot's is.
+  const allMarked = await cpage.waitForFunction(() => {
+    const active = [...document.querySelectorAll('.label.active')].map((e) => e.textContent);
+    return window.rccxView.robots.every((r) => r.goal && active.some((t) => t.endsWith(r.goal)));
+  }, null, { timeout: 30000 }).then(() => true, () => false);
   const marks = await cpage.evaluate(() => ({
     goals: window.rccxView.robots.map((r) => r.goal),
     active: [...document.querySelectorAll('.label.active')].map((e) => e.textContent),
   }));
-  check(marks.goals.every((g, i) => g.startsWith(`${names[i]}_P`)) && marks.active.length >= 1,
+  check(allMarked && marks.goals.every((g, i) => g.startsWith(`${names[i]}_P`)) && marks.active.length >= 1,
     `each robot's running goal is marked (${marks.goals.join(', ')}; marked: ${marks.active.join(', ')})`);
   await cpage.screenshot({ path: join(artifacts, 'view-cell.png') });
   check(cerrors.length === 0, `no console error on the cell's page (${cerrors.join('; ') || 'none'})`);
