@@ -211,7 +211,6 @@ Cell::Cell(CellModel model, CellOptions options)
       if (cr.model.joints[j].type == kin::JointType::prismatic) r->travel_factor[j] = 1.0;
     }
     generators_.push_back(r->generator);
-    sessions_.push_back(r->session);
     robots_.push_back(std::move(r));
   }
   std::vector<Solid> solids;

@@ -248,10 +248,9 @@ class Cell {
   CellOptions options_;
   // Declared before the group: the cycle hook uses them until the group's tasks stop.
   std::vector<std::unique_ptr<Robot>> robots_;
-  /// Each robot's generator and session, side by side, so that the tick's last pass can fetch
-  /// the next robots' ahead of use.
+  /// Each robot's generator, side by side, so that the tick's last pass can fetch the next
+  /// robots' ahead of use.
   std::vector<const rccl::TrajectoryGenerator*> generators_;
-  std::vector<const rtc::Session*> sessions_;
   std::unique_ptr<CollisionWorld> world_;
   std::vector<Threat> threats_;  ///< the check's buffer: one per robot pair, robot and object
   std::array<char, rccl::kEventText> message_{};
