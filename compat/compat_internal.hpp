@@ -192,6 +192,22 @@ rc::PositionPtr build_position(const PositionBox& p, const math::Transform& extr
 void refresh() noexcept;
 /// Prints the motions of the one-robot session that failed since the last call.
 void report_failures();
+/// Calls take(word) for each word of `text` (separated by spaces, commas or tabs; empty words
+/// too, which take() skips): the argument strings of distance(), comply(), limit() and
+/// mnp_touch().
+template <class F>
+void for_each_word(const std::string& text, F&& take) {
+  std::string word;
+  for (const char c : text) {
+    if (c == ' ' || c == ',' || c == '\t') {
+      take(word);
+      word.clear();
+    } else {
+      word += c;
+    }
+  }
+  take(word);
+}
 /// POS.code of each motion's position from the arm's events since the last call: 0 ended,
 /// RCCL_NEXTMOVE / RCCL_ONF ended early by nextmove, RTC_E_MOTION failed or cancelled.
 void show_motion_codes(rc::Manipulator& arm,

@@ -800,26 +800,6 @@ int stop(double ms) {
   return code;
 }
 
-extern "C++" {
-namespace {
-/// Calls take(word) for each word of `text` (separated by spaces, commas or tabs; empty words
-/// too, which take() skips): the argument strings of distance(), comply() and limit().
-template <class F>
-void for_each_word(const std::string& text, F&& take) {
-  std::string word;
-  for (const char c : text) {
-    if (c == ' ' || c == ',' || c == '\t') {
-      take(word);
-      word.clear();
-    } else {
-      word += c;
-    }
-  }
-  take(word);
-}
-}  // namespace
-}
-
 int distance(const char* what, ...) {
   std::va_list ap;
   va_start(ap, what);

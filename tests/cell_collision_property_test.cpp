@@ -101,6 +101,7 @@ class Oracle {
   struct Box {
     Eigen::Isometry3d inverse;
     Eigen::Vector3d half;
+    Eigen::Vector3d centre;  ///< in the world
     std::string name;
   };
 
@@ -108,6 +109,7 @@ class Oracle {
     for (const cell::CellObject& o : m.objects) {
       Box b;
       b.inverse = iso(o.pose).inverse();
+      b.centre = vec(o.pose.p);
       b.half = Eigen::Vector3d(o.shape.size_m.x, o.shape.size_m.y, o.shape.size_m.z) / 2.0;
       b.name = o.name;
       boxes_.push_back(b);
@@ -174,8 +176,7 @@ class Oracle {
   /// `beyond_m` from the box's circumscribed sphere gives that bound instead.
   double distance(const Part& a, std::size_t box, double beyond_m = kInf) const {
     const Box& b = boxes_[box];
-    const Eigen::Vector3d centre = b.inverse.inverse().translation();
-    const double bound = point_segment(centre, a.p0, a.p1) - b.half.norm() - a.radius;
+    const double bound = point_segment(b.centre, a.p0, a.p1) - b.half.norm() - a.radius;
     if (bound > beyond_m) return bound;
     const auto f = [&](double s) {
       const Eigen::Vector3d x = b.inverse * (a.p0 + (a.p1 - a.p0) * s);

@@ -208,6 +208,32 @@ TEST(CellRuntime, TwoArmsDrivenTowardsEachOtherStopOutsideTheMargin) {
   EXPECT_GE(closest_m, margin_m);
 }
 
+TEST(CellRuntime, WhatAMotionMayTouchIsNamedAndAnUnknownNameIsRefused) {
+  cell::CellModel model = cell::load_cell_file(kCvarl);
+  const auto c = std::make_unique<cell::Cell>(model);
+  EXPECT_EQ(c->objects({"xy_stage", "board"}), 0b110U);  // objects 2 and 3 of the file
+  EXPECT_EQ(c->touching({"board"}).touch, 0b100U);
+  EXPECT_EQ(c->objects({}), 0U);
+  try {
+    (void)c->touching({"bord"});
+    ADD_FAILURE() << "an unknown object was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("no object \"bord\"; its objects: table, xy_stage, board"),
+              std::string::npos)
+        << e.what();
+  }
+  // Only the first 64 objects fit a motion's touch set.
+  for (int k = 0; k < 64; ++k) {
+    cell::CellObject o = model.objects[0];
+    o.name = "far" + std::to_string(k);
+    o.pose = math::Transform::translation(5.0 + k, 5.0, 0.0);
+    model.objects.push_back(o);
+  }
+  const auto many = std::make_unique<cell::Cell>(model);
+  EXPECT_NO_THROW((void)many->objects({"far60"}));
+  EXPECT_THROW((void)many->objects({"far61"}), std::invalid_argument);
+}
+
 TEST(CellRuntime, TwoArmsStanding40mmApartAreSeparatedWithNoStop) {
   // The Microbo's arm swings from its ready pose towards the PUMA's wrist (a straight line in
   // its joints) until its closest part is 40 mm from the PUMA's: inside the zone where any

@@ -181,6 +181,14 @@ TEST_F(Compat, TheCellsRobotHandlesRefuseWhatCannotWork) {
   EXPECT_EQ(move(park), RTC_E_SEQUENCE) << "the one-robot move() names no robot";
   EXPECT_NE(message().find("mnp_move"), std::string::npos) << message();
   EXPECT_EQ(rccl_together(0, puma, reinterpret_cast<MANIP*>(&rtc_error), nullptr), RTC_E_ARGUMENT);
+  // What a motion may touch: the cell's objects, named; a typo is refused naming them.
+  EXPECT_EQ(mnp_touch(mbo, "board, tabel"), RTC_E_ARGUMENT);
+  EXPECT_NE(message().find("no object \"tabel\"; its objects: table, xy_stage, board"),
+            std::string::npos)
+      << message();
+  EXPECT_EQ(mnp_touch(nullptr, "board"), RTC_E_ARGUMENT);
+  EXPECT_EQ(mnp_touch(mbo, "board,xy_stage"), RTC_OK) << message();
+  EXPECT_EQ(mnp_touch(mbo, ""), RTC_OK) << "none, as every motion starts";
   // A hand-off: the Microbo's park waits for the PUMA's park to end.
   ASSERT_EQ(mnp_move(puma, mnp_park(puma)), RTC_OK) << message();
   const int a = mnp_last_motion(puma);

@@ -22,13 +22,6 @@ rtc::SessionOptions group_options(const CellModel& m, const CellOptions& o) {
   return so;
 }
 
-/// "link 4", or a shape's name, without allocating.
-std::string_view part_text(std::array<char, 16>& buf, std::string_view shape, int link) {
-  if (!shape.empty()) return shape;
-  const auto r = fmt::format_to_n(buf.data(), buf.size(), "link {}", link);
-  return {buf.data(), static_cast<std::size_t>(r.out - buf.data())};
-}
-
 /// R(dt) from angular velocity w (world frame) applied to R.
 math::Rot3 rotate(const math::Rot3& R, const math::Vec3& w, double dt) noexcept {
   const double rate = w.norm();
@@ -129,10 +122,11 @@ void Cell::check_clear_at_start() const {
       if (!(c.distance_m < 0.0)) continue;
       const RobotCapsules& r = world_->robot(i);
       const Capsule& cap = r.capsules()[c.capsule];
+      std::array<char, 16> buf{};
       throw CellFileError(fmt::format(
           "cell {}: robot {}'s {} lies {:.1f} mm inside object {} at its ready pose; move the "
           "robot or the object{}",
-          model_.name, model_.robots[i].name, part_name(r, cap), -c.distance_m * 1e3,
+          model_.name, model_.robots[i].name, part_name(r, cap, buf), -c.distance_m * 1e3,
           model_.objects[k].name,
           cap.mounting ? fmt::format(", or say that it stands there (\"mounted_on\": \"{}\")",
                                      model_.objects[k].name)
@@ -541,7 +535,7 @@ void Cell::check_collisions() noexcept {
     const Capsule& pa = ca.capsules()[t.capsule_a];
     try {
       std::array<char, 16> buf_a{}, buf_b{};
-      const std::string_view part_a = part_text(buf_a, ca.shape_name(pa), pa.link + 1);
+      const std::string_view part_a = part_name(ca, pa, buf_a);
       fmt::format_to_n_result<char*> out{message_.data(), 0};
       const std::size_t room = message_.size() - 1;
       if (t.solid) {
@@ -554,7 +548,7 @@ void Cell::check_collisions() noexcept {
         const Robot& b = *robots_[t.b];
         const RobotCapsules& cb = world_->robot(t.b);
         const Capsule& pb = cb.capsules()[t.capsule_b];
-        const std::string_view part_b = part_text(buf_b, cb.shape_name(pb), pb.link + 1);
+        const std::string_view part_b = part_name(cb, pb, buf_b);
         out = fmt::format_to_n(
             message_.data(), room,
             "collision stop: {} {} and {} {} would come {:.3f} m apart (margin {:.3f} m + "

@@ -44,7 +44,7 @@ CollisionWorld::CollisionWorld(std::vector<RobotCapsules> robots, double margin_
     throw std::invalid_argument("collision margin " + std::to_string(margin_m) +
                                 " m; it must be finite and not negative");
   }
-  margin_m_base_ = margin_m;
+  clearance_m_ = margin_m;
   if (robots_.size() > std::numeric_limits<std::uint32_t>::max()) {
     throw std::invalid_argument("too many robots for one collision world");
   }
@@ -91,7 +91,7 @@ bool CollisionWorld::robot_threat(std::size_t a, std::size_t b, Threat& out) noe
   const RobotCapsules& rb = robots_[b];
   // Neither moved since the last check: nothing approaches.
   if (!ra.moved() && !rb.moved()) return false;
-  const double limit = margin_m_base_ + allowance_m_[a] + allowance_m_[b];
+  const double limit = clearance_m_ + allowance_m_[a] + allowance_m_[b];
   const std::span<const Capsule> ca_now = ra.capsules(), cb_now = rb.capsules();
   const std::span<const Capsule> ca_was = ra.before(), cb_was = rb.before();
   bool found = false;
@@ -116,7 +116,7 @@ bool CollisionWorld::robot_threat(std::size_t a, std::size_t b, Threat& out) noe
 bool CollisionWorld::solid_threat(std::size_t r, std::size_t s, Threat& out) noexcept {
   const RobotCapsules& robot = robots_[r];
   const Solid& solid = solids_[s];
-  const double limit = margin_m_base_ + allowance_m_[r];
+  const double limit = clearance_m_ + allowance_m_[r];
   if (!overlap(robot.bounds(), solid.bounds, limit)) return false;
   const std::span<const Capsule> now = robot.capsules(), was = robot.before();
   bool found = false;
@@ -145,11 +145,9 @@ std::size_t CollisionWorld::threats(std::span<Threat> out) noexcept {
       second = a;
     }
   }
-  const double saved = margin_m_;
-  margin_m_ = margin_m_base_ + widest + second;
   std::size_t count = 0;
   Threat t;
-  sweep([&](std::size_t a, std::size_t b) {
+  sweep(clearance_m_ + widest + second, [&](std::size_t a, std::size_t b) {
     if (!robot_threat(a, b, t)) return;
     if (count < out.size()) out[count] = t;
     ++count;
@@ -162,7 +160,6 @@ std::size_t CollisionWorld::threats(std::span<Threat> out) noexcept {
       ++count;
     }
   }
-  margin_m_ = saved;
   for (RobotCapsules& r : robots_) r.settle();
   return count;
 }
@@ -229,17 +226,17 @@ void CollisionWorld::sort_boxes() noexcept {
 }
 
 template <class OnPair>
-void CollisionWorld::sweep(OnPair&& on_pair) noexcept {
+void CollisionWorld::sweep(double margin_m, OnPair&& on_pair) noexcept {
   sort_boxes();
   stats_ = {};
   const std::size_t n = order_.size();
   for (std::size_t i = 0; i < n; ++i) {
     const Entry& ei = order_[i];
-    const double reach = along(ei.box.hi_m, axis_) + margin_m_;
+    const double reach = along(ei.box.hi_m, axis_) + margin_m;
     // Sorted by the low end: the first box that starts beyond this one's reach ends the scan.
     for (std::size_t j = i + 1; j < n && order_[j].key <= reach; ++j) {
       const Entry& ej = order_[j];
-      if (!overlap(ei.box, ej.box, margin_m_)) continue;
+      if (!overlap(ei.box, ej.box, margin_m)) continue;
       ++stats_.robot_pairs;
       on_pair(std::min(ei.robot, ej.robot), std::max(ei.robot, ej.robot));
     }
@@ -272,7 +269,7 @@ bool CollisionWorld::closest_below(std::size_t a, std::size_t b, double limit_m,
 std::optional<Contact> CollisionWorld::check() noexcept {
   std::optional<Contact> best;
   Contact c;
-  sweep([&](std::size_t a, std::size_t b) {
+  sweep(margin_m_, [&](std::size_t a, std::size_t b) {
     // Only a pair closer than the best so far can replace it.
     const double limit = best ? best->distance_m : margin_m_;
     if (closest_below(a, b, limit, c)) best = c;
@@ -283,7 +280,7 @@ std::optional<Contact> CollisionWorld::check() noexcept {
 std::size_t CollisionWorld::contacts(std::span<Contact> out) noexcept {
   std::size_t count = 0;
   Contact c;
-  sweep([&](std::size_t a, std::size_t b) {
+  sweep(margin_m_, [&](std::size_t a, std::size_t b) {
     if (!closest_below(a, b, margin_m_, c)) return;
     if (count < out.size()) out[count] = c;
     ++count;

@@ -144,9 +144,9 @@ class CollisionWorld {
 
   /// Refreshes the boxes, picks the axis and restores the order.
   void sort_boxes() noexcept;
-  /// Calls on_pair(a, b) for each robot pair whose boxes come within the margin.
+  /// Calls on_pair(a, b) for each robot pair whose boxes come within margin_m.
   template <class OnPair>
-  void sweep(OnPair&& on_pair) noexcept;
+  void sweep(double margin_m, OnPair&& on_pair) noexcept;
   /// The closest capsule pair of robots a and b closer than limit_m, into out; false if none.
   bool closest_below(std::size_t a, std::size_t b, double limit_m, Contact& out) noexcept;
 
@@ -162,8 +162,8 @@ class CollisionWorld {
   std::vector<std::uint64_t> touch_;
   std::vector<Entry> order_;
   int axis_ = 0;
-  double margin_m_ = 0.0;       ///< the broad phase's (set_margin)
-  double margin_m_base_ = 0.0;  ///< the clearance threats() keeps, as constructed
+  double margin_m_ = 0.0;     ///< the broad phase's (set_margin)
+  double clearance_m_ = 0.0;  ///< the clearance threats() keeps, as constructed
   CheckStats stats_;
 };
 

@@ -146,9 +146,11 @@ bool RobotCapsules::update(const kin::JointVector& q) noexcept {
   return true;
 }
 
-std::string part_name(const RobotCapsules& robot, const Capsule& c) {
-  if (c.shape >= 0) return std::string(robot.shape_name(c));
-  return "link " + std::to_string(c.link + 1);
+std::string_view part_name(const RobotCapsules& robot, const Capsule& c,
+                           std::array<char, 16>& buf) noexcept {
+  if (c.shape >= 0) return robot.shape_name(c);
+  const auto r = fmt::format_to_n(buf.data(), buf.size(), "link {}", c.link + 1);
+  return {buf.data(), static_cast<std::size_t>(r.out - buf.data())};
 }
 
 }  // namespace rccx::cell

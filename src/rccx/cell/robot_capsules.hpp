@@ -118,7 +118,9 @@ class RobotCapsules {
   int mounted_on_ = -1;
 };
 
-/// A capsule's name in messages: "link 4", or its shape's name.
-std::string part_name(const RobotCapsules& robot, const Capsule& c);
+/// A capsule's name in messages: "link 4" (written into `buf`), or its shape's name. Allocates
+/// nothing: the sample loop's stop messages use it.
+std::string_view part_name(const RobotCapsules& robot, const Capsule& c,
+                           std::array<char, 16>& buf) noexcept;
 
 }  // namespace rccx::cell
