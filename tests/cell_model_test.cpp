@@ -156,7 +156,7 @@ TEST(CellFile, ShapesAndMountingLoad) {
   EXPECT_EQ(c.robots[1].mounted_on, "table");
   // Shapes in T6 replace the default tool capsule; without them the tool gets one.
   EXPECT_EQ(cell::Cell::shapes_of(c.robots[1]).size(), 3U);
-  const std::vector<cell::ShapeSpec> tool = cell::Cell::shapes_of(valid_model());
+  const std::vector<cell::RobotShape> tool = cell::Cell::shapes_of(valid_model());
   ASSERT_EQ(tool.size(), 1U);
   EXPECT_EQ(tool[0].name, "tool");
   EXPECT_DOUBLE_EQ(tool[0].to_m.z, 0.1);

@@ -287,9 +287,9 @@ TEST(RobotCapsules, EveryJointHasACapsuleAndShapesFollowTheirFrames) {
   for (const char* name : kCapsuleRobots) {
     SCOPED_TRACE(name);
     const kin::RobotModel model = kin::builtin_robot(name);
-    const std::vector<cell::ShapeSpec> shapes{
-        {"pedestal", 0, {0, 0, -0.3}, {0, 0, -0.1}, 0.07},
-        {"probe", model.dof(), {0, 0, 0.02}, {0.01, 0, 0.12}, 0.004}};
+    const std::vector<cell::RobotShape> shapes{
+        {"pedestal", 0, {0, 0, -0.3}, {0, 0, -0.1}, 0.07, ""},
+        {"probe", model.dof(), {0, 0, 0.02}, {0.01, 0, 0.12}, 0.004, ""}};
     const Transform base{math::Rot3::from_rpy(0.4, 0.1, -0.2), {0.2, 0.3, -0.1}};
     RobotCapsules robot(model, std::span(&r, 1), base, shapes);
     const auto kinematics = kin::make_kinematics(model);
@@ -309,7 +309,7 @@ TEST(RobotCapsules, EveryJointHasACapsuleAndShapesFollowTheirFrames) {
         const std::string_view n = robot.shape_name(c);
         // The shape's points, placed by forward kinematics (the tool) or the base alone.
         const Transform frame = n == "probe" ? base * kinematics->forward(q) : base;
-        const cell::ShapeSpec& spec = n == "probe" ? shapes[1] : shapes[0];
+        const cell::RobotShape& spec = n == "probe" ? shapes[1] : shapes[0];
         ASSERT_LT((c.p0_m - frame * spec.from_m).norm(), 1e-12) << n;
         ASSERT_LT((c.p1_m - frame * spec.to_m).norm(), 1e-12) << n;
         EXPECT_EQ(c.tool, n == "probe");
@@ -330,7 +330,7 @@ TEST(RobotCapsules, EveryJointHasACapsuleAndShapesFollowTheirFrames) {
   for (const Capsule& c : microbo.capsules()) mounting += c.mounting ? 1 : 0;
   EXPECT_EQ(mounting, 2U);
   EXPECT_EQ(microbo.capsules().size(), 6U);  // sphere, column, arm, three wrist spheres
-  const std::vector<cell::ShapeSpec> bad{{"x", 7, {}, {}, 0.01}};
+  const std::vector<cell::RobotShape> bad{{"x", 7, {}, {}, 0.01, ""}};
   EXPECT_THROW(
       RobotCapsules(kin::builtin_robot("microbo"), std::span(&r, 1), Transform::identity(), bad),
       std::invalid_argument);
@@ -394,7 +394,7 @@ TEST(CollisionWorld, ThreatsOnlyWhilePartsApproach) {
   // Two Microbos facing each other 1 m apart, arms drawn in, and a table under both.
   const kin::RobotModel m = kin::builtin_robot("microbo");
   const double r = 0.04;
-  const std::vector<cell::ShapeSpec> tool{{"probe", m.dof(), {0, 0, 0}, {0, 0, 0.125}, 0.005}};
+  const std::vector<cell::RobotShape> tool{{"probe", m.dof(), {0, 0, 0}, {0, 0, 0.125}, 0.005, ""}};
   std::vector<RobotCapsules> robots;
   robots.emplace_back(m, std::span(&r, 1), Transform::translation(-0.5, 0, 0), tool);
   robots.emplace_back(m, std::span(&r, 1), Transform{math::Rot3::rot_z(math::kPi), {0.5, 0, 0}},

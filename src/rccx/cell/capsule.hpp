@@ -3,7 +3,9 @@
 #pragma once
 
 #include <algorithm>
+#include <cstddef>
 #include <cstdint>
+#include <string>
 
 #include "rccx/math/transform.hpp"
 
@@ -22,6 +24,21 @@ struct Aabb {
          a.lo_m.y <= b.hi_m.y + margin_m && b.lo_m.y <= a.hi_m.y + margin_m &&
          a.lo_m.z <= b.hi_m.z + margin_m && b.lo_m.z <= a.hi_m.z + margin_m;
 }
+
+/// A named capsule fixed in one of a robot's frames, for the collision check: what the DH chain
+/// does not say (a pedestal, a flange, a hand, the tool). Points in that frame, m. Read from a
+/// cell file (CellRobot::shapes), placed in the world by RobotCapsules.
+struct RobotShape {
+  std::string name;       ///< "pedestal", "flange", "probe": what a stop message calls it
+  std::size_t frame = 0;  ///< 0: the base frame; i: link i's frame; dof: T6
+  math::Vec3 from_m;
+  math::Vec3 to_m;
+  double radius_m = 0.0;
+  std::string note;
+};
+
+/// Shapes a robot may carry.
+inline constexpr std::size_t kMaxRobotShapes = 16;
 
 /// A capsule in world coordinates: the points within radius_m of the segment p0_m .. p1_m.
 struct Capsule {

@@ -68,18 +68,18 @@ double Cell::braking_fast(const Robot& r, const kin::JointVector& q0,
   return d;
 }
 
-std::vector<ShapeSpec> Cell::shapes_of(const CellRobot& robot) {
-  std::vector<ShapeSpec> out;
+std::vector<RobotShape> Cell::shapes_of(const CellRobot& robot) {
+  std::vector<RobotShape> out;
   bool hand = false;
   for (const RobotShape& s : robot.shapes) {
-    out.push_back({s.name, s.frame, s.from_m, s.to_m, s.radius_m});
+    out.push_back(s);
     hand = hand || s.frame == robot.model.dof();
   }
   // A tool the file gives no shape for is a capsule to the tool point, as thick as the last
   // link: what is there is not known, so not thinner than the arm.
   if (robot.tool && !hand) {
     const double r = robot.link_radius_m.empty() ? 0.0 : robot.link_radius_m.back();
-    out.push_back({"tool", robot.model.dof(), {0, 0, 0}, robot.tool->p, r});
+    out.push_back({"tool", robot.model.dof(), {0, 0, 0}, robot.tool->p, r, "T6 to the tool point"});
   }
   return out;
 }
@@ -89,7 +89,7 @@ kin::JointVector Cell::levers_m(const CellRobot& robot) {
   kin::JointVector lever(m.dof());
   // How far a shape fixed in frame f reaches from that frame's origin.
   std::array<double, kin::kMaxJoints + 1> reach{};
-  for (const ShapeSpec& s : shapes_of(robot)) {
+  for (const RobotShape& s : shapes_of(robot)) {
     if (s.frame == 0 || s.frame > m.dof()) continue;  // the base's shapes do not move
     reach[s.frame] =
         std::max(reach[s.frame], std::max(s.from_m.norm(), s.to_m.norm()) + s.radius_m);
@@ -182,7 +182,7 @@ Cell::Cell(CellModel model, CellOptions options)
     r->tool = cr.tool.value_or(math::Transform::identity());
     r->period_s = std::chrono::duration<double>(model_.period(i)).count();
     r->lever_m = levers_m(cr);
-    const std::vector<ShapeSpec> shapes = shapes_of(cr);
+    const std::vector<RobotShape> shapes = shapes_of(cr);
     capsules.emplace_back(cr.model, cr.link_radius_m, cr.base, shapes);
     if (!cr.mounted_on.empty()) {
       for (std::size_t k = 0; k < model_.objects.size(); ++k) {

@@ -190,7 +190,7 @@ class Cell {
   static kin::JointVector levers_m(const CellRobot& robot);
   /// A robot's named capsules for the collision check: the cell file's shapes and, for a tool
   /// without a shape in T6, a capsule from T6's origin to the tool's, the last link's radius.
-  static std::vector<ShapeSpec> shapes_of(const CellRobot& robot);
+  static std::vector<RobotShape> shapes_of(const CellRobot& robot);
 
   /// The objects (by name) a motion's tool may touch, for StartWhen::touch. Throws
   /// std::invalid_argument naming the cell's objects for an unknown name, or for an object past the

@@ -17,6 +17,7 @@
 #include <string_view>
 #include <vector>
 
+#include "rccx/cell/capsule.hpp"
 #include "rccx/kinematics/robot_model.hpp"
 #include "rccx/math/transform.hpp"
 
@@ -37,20 +38,6 @@ inline constexpr double kMaxRadius_m = 1.0;
 /// Names of robots, objects and frames: as transform names (letters, digits, _ - .).
 inline constexpr std::size_t kMaxName = 32;
 inline constexpr std::size_t kMaxText = 4096;  ///< bytes of a title, source or note
-
-/// A named capsule fixed in one of a robot's frames, for the collision check: what the DH chain
-/// does not say (a pedestal, a flange, a hand, the tool). Points in that frame, m.
-struct RobotShape {
-  std::string name;       ///< "pedestal", "flange", "probe"
-  std::size_t frame = 0;  ///< 0: the base frame; i: link i's frame; dof: T6
-  math::Vec3 from_m;
-  math::Vec3 to_m;
-  double radius_m = 0.0;
-  std::string note;
-};
-
-/// Shapes a robot may carry (cell/robot_capsules.hpp holds as many).
-inline constexpr std::size_t kMaxRobotShapes = 16;
 
 /// One robot of the cell.
 struct CellRobot {

@@ -22,7 +22,7 @@ bool finite(const math::Vec3& v) {
 }  // namespace
 
 RobotCapsules::RobotCapsules(const kin::RobotModel& model, std::span<const double> link_radius_m,
-                             const math::Transform& base, std::span<const ShapeSpec> shapes)
+                             const math::Transform& base, std::span<const RobotShape> shapes)
     : base_(base) {
   const std::size_t dof = model.dof();
   if (dof == 0 || dof > kin::kMaxJoints) {
@@ -73,7 +73,7 @@ RobotCapsules::RobotCapsules(const kin::RobotModel& model, std::span<const doubl
     // Neither: the joint as a sphere at frame i's origin (where frame i-1's is too).
     if (!d_part && !a_part) add(i + 1, false, {0, 0, 0}, {0, 0, 0});
   }
-  for (const ShapeSpec& s : shapes) {
+  for (const RobotShape& s : shapes) {
     if (s.frame > dof) {
       throw std::invalid_argument(
           fmt::format("robot {}: shape \"{}\" is in frame {}; 0 (the base) to {} (T6)", model.name,

@@ -6,7 +6,7 @@
 // prismatic joint's d part is always one, since its length changes with q). A link with
 // neither (a wrist joint: the PUMA's links 5 and 6, the Microbo's 1, 4, 5 and 6) is a sphere
 // at its frame's origin, so that no joint is left out. Radii: one per link, from the cell file.
-// Named shapes (ShapeSpec) add what the DH chain does not say: a pedestal in the base frame, a
+// Named shapes (RobotShape) add what the DH chain does not say: a pedestal in the base frame, a
 // flange, a hand and the tool in T6.
 //
 // What the pieces are is worked out once at construction (which may allocate and throw);
@@ -30,20 +30,10 @@
 
 namespace rccx::cell {
 
-/// A named capsule fixed in one of the robot's frames: 0 the base frame, i = 1 .. dof link i's
-/// frame (dof: T6, where the flange, the hand and the tool are). Points in that frame, m.
-struct ShapeSpec {
-  std::string name;  ///< "pedestal", "flange", "probe": what a stop message calls it
-  std::size_t frame = 0;
-  math::Vec3 from_m;
-  math::Vec3 to_m;
-  double radius_m = 0.0;
-};
-
 class RobotCapsules {
  public:
   /// Two capsules per joint (the d part and the a part, or the joint's sphere) and the shapes.
-  static constexpr std::size_t kMaxShapes = 16;
+  static constexpr std::size_t kMaxShapes = kMaxRobotShapes;
   static constexpr std::size_t kMaxCapsules = 2 * kin::kMaxJoints + kMaxShapes;
 
   /// `link_radius_m` holds one radius (m) for every link or one per joint; `base` places the
@@ -53,7 +43,7 @@ class RobotCapsules {
   /// T6, a point or radius not finite). The capsules start at the model's ready pose.
   RobotCapsules(const kin::RobotModel& model, std::span<const double> link_radius_m,
                 const math::Transform& base = math::Transform::identity(),
-                std::span<const ShapeSpec> shapes = {});
+                std::span<const RobotShape> shapes = {});
 
   /// Moves the capsules to joint values q (rad / m). False, and nothing changed, when q has the
   /// wrong size or a value that is not finite. The capsules as they were go to before() unless

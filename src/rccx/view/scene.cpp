@@ -17,11 +17,8 @@ Scene Scene::of_cell(const cell::CellModel& model) {
   Scene s;
   s.title = model.title.empty() ? model.name : model.title;
   for (const cell::CellRobot& r : model.robots) {
-    std::vector<cell::RobotShape> shapes;
-    for (const cell::ShapeSpec& k : cell::Cell::shapes_of(r)) {
-      shapes.push_back({k.name, k.frame, k.from_m, k.to_m, k.radius_m, ""});
-    }
-    s.robots.push_back({r.name, r.model, r.base, r.tool, r.link_radius_m, std::move(shapes)});
+    s.robots.push_back(
+        {r.name, r.model, r.base, r.tool, r.link_radius_m, cell::Cell::shapes_of(r)});
   }
   s.objects = model.objects;
   for (const cell::CellFrame& f : model.frames) s.frames.push_back({f.name, f.pose, f.note});
