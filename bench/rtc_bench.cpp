@@ -13,7 +13,7 @@
 #include "rccx/hw/simulated_arm.hpp"
 #include "rccx/rtc/servo_driver.hpp"
 #include "rccx/rtc/session.hpp"
-#include "rccx/rtc/sync.hpp"
+#include "rccx/rtc/doorbell.hpp"
 
 namespace {
 

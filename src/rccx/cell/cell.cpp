@@ -8,6 +8,8 @@
 #include <limits>
 #include <stdexcept>
 
+#include "rccx/io/fixed_text.hpp"
+
 namespace rccx::cell {
 
 namespace {
@@ -353,15 +355,8 @@ void Cell::publish_ledgers() noexcept {
         code == rtc::TerminateCode::user_request || code == rtc::TerminateCode::user_interrupt) {
       continue;
     }
-    try {
-      const auto out = fmt::format_to_n(message_.data(), message_.size() - 1,
-                                        "stopped: {}'s control ended ({}: {}); the cell holds "
-                                        "every arm",
-                                        r.name, rtc::to_string(code), rtc::describe(code));
-      *out.out = '\0';
-    } catch (...) {  // fmt allocates nothing here; the stop matters more than its words
-      message_[0] = '\0';
-    }
+    io::format_fixed(message_, "stopped: {}'s control ended ({}: {}); the cell holds every arm",
+                     r.name, rtc::to_string(code), rtc::describe(code));
     for (auto& other : robots_) {
       if (other.get() != &r) other->manipulator->generator().request_stop(message_.data());
     }
@@ -533,32 +528,24 @@ void Cell::check_collisions() noexcept {
     Robot& a = *robots_[t.robot_a];
     const RobotCapsules& ca = world_->robot(t.robot_a);
     const Capsule& pa = ca.capsules()[t.capsule_a];
-    try {
-      std::array<char, 16> buf_a{}, buf_b{};
-      const std::string_view part_a = part_name(ca, pa, buf_a);
-      fmt::format_to_n_result<char*> out{message_.data(), 0};
-      const std::size_t room = message_.size() - 1;
-      if (t.solid) {
-        out = fmt::format_to_n(message_.data(), room,
-                               "collision stop: {} {} would come {:.3f} m from object {} (margin "
-                               "{:.3f} m + braking {:.3f} m)",
-                               a.name, part_a, t.distance_m, model_.objects[t.b].name,
-                               model_.collision_margin_m, a.braking_m);
-      } else {
-        const Robot& b = *robots_[t.b];
-        const RobotCapsules& cb = world_->robot(t.b);
-        const Capsule& pb = cb.capsules()[t.capsule_b];
-        const std::string_view part_b = part_name(cb, pb, buf_b);
-        out = fmt::format_to_n(
-            message_.data(), room,
-            "collision stop: {} {} and {} {} would come {:.3f} m apart (margin {:.3f} m + "
-            "braking {:.3f} m)",
-            a.name, part_a, b.name, part_b, t.distance_m, model_.collision_margin_m,
-            a.braking_m + b.braking_m);
-      }
-      *out.out = '\0';
-    } catch (...) {  // fmt allocates nothing here; the stop matters more than its words
-      message_[0] = '\0';
+    std::array<char, 16> buf_a{}, buf_b{};
+    const std::string_view part_a = part_name(ca, pa, buf_a);
+    if (t.solid) {
+      io::format_fixed(message_,
+                       "collision stop: {} {} would come {:.3f} m from object {} (margin {:.3f} m "
+                       "+ braking {:.3f} m)",
+                       a.name, part_a, t.distance_m, model_.objects[t.b].name,
+                       model_.collision_margin_m, a.braking_m);
+    } else {
+      const Robot& b = *robots_[t.b];
+      const RobotCapsules& cb = world_->robot(t.b);
+      const Capsule& pb = cb.capsules()[t.capsule_b];
+      const std::string_view part_b = part_name(cb, pb, buf_b);
+      io::format_fixed(message_,
+                       "collision stop: {} {} and {} {} would come {:.3f} m apart (margin {:.3f} "
+                       "m + braking {:.3f} m)",
+                       a.name, part_a, b.name, part_b, t.distance_m, model_.collision_margin_m,
+                       a.braking_m + b.braking_m);
     }
     const std::string_view why(message_.data());
     a.manipulator->generator().request_stop(why);

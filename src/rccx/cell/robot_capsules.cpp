@@ -7,6 +7,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "rccx/io/fixed_text.hpp"
+
 namespace rccx::cell {
 
 namespace {
@@ -149,8 +151,7 @@ bool RobotCapsules::update(const kin::JointVector& q) noexcept {
 std::string_view part_name(const RobotCapsules& robot, const Capsule& c,
                            std::array<char, 16>& buf) noexcept {
   if (c.shape >= 0) return robot.shape_name(c);
-  const auto r = fmt::format_to_n(buf.data(), buf.size(), "link {}", c.link + 1);
-  return {buf.data(), static_cast<std::size_t>(r.out - buf.data())};
+  return io::format_fixed(buf, "link {}", c.link + 1);
 }
 
 }  // namespace rccx::cell

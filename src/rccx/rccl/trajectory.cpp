@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 
+#include "rccx/io/fixed_text.hpp"
 #include "rccx/math/units.hpp"
 #include "rccx/rccl/paul_transition.hpp"
 #include "rccx/rtc/types.hpp"
@@ -89,16 +90,11 @@ double distance_to_segment(const math::Vec3& p, const math::Vec3& a, const math:
   return (p - (a + ab * s)).norm();
 }
 
-/// Formats into a fixed buffer: no allocation, for messages made in the sample loop.
+/// A message made in the sample loop, by value (io::format_fixed: no allocation).
 template <class... Args>
 std::array<char, kEventText> text(fmt::format_string<Args...> f, Args&&... args) noexcept {
   std::array<char, kEventText> to{};
-  try {
-    const auto r = fmt::format_to_n(to.data(), kEventText - 1, f, std::forward<Args>(args)...);
-    *r.out = '\0';
-  } catch (...) {
-    to[0] = '\0';
-  }
+  io::format_fixed(to, f, std::forward<Args>(args)...);
   return to;
 }
 

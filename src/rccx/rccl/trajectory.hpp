@@ -59,7 +59,7 @@
 #include "rccx/kinematics/kinematics.hpp"
 #include "rccx/rccl/force_settings.hpp"
 #include "rccx/rccl/position.hpp"
-#include "rccx/rccl/sync.hpp"
+#include "rccx/rccl/motion_sync.hpp"
 
 namespace rccx::rccl {
 

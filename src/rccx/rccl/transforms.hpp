@@ -22,7 +22,7 @@
 #include <string_view>
 
 #include "rccx/math/transform.hpp"
-#include "rccx/rtc/sync.hpp"
+#include "rccx/rtc/latest.hpp"
 
 namespace rccx::rtc {
 struct How;

@@ -15,9 +15,11 @@
 #include <utility>
 
 #include "rccx/io/console.hpp"
+#include "rccx/io/fixed_text.hpp"
 #include "rccx/kinematics/kinematics.hpp"
+#include "rccx/rtc/doorbell.hpp"
 #include "rccx/rtc/hangup.hpp"
-#include "rccx/rtc/sync.hpp"
+#include "rccx/rtc/latest.hpp"
 
 namespace rccx::rtc {
 
@@ -34,24 +36,6 @@ enum Phase : std::uint32_t { kIdle, kControlling, kEnding, kEnded };
 
 // Requests from release(), carried out by the communication task at its next tick.
 enum Pending : std::uint32_t { kPendingHold = 1, kPendingPowerOff = 2 };
-
-template <std::size_t N>
-void copy_text(std::array<char, N>& to, std::string_view text) noexcept {
-  const std::size_t n = std::min(text.size(), N - 1);
-  if (n > 0) std::memcpy(to.data(), text.data(), n);  // an empty view may hold no pointer
-  to[n] = '\0';
-}
-
-// Formats into a fixed buffer: the communication task reports details without allocating.
-template <std::size_t N, class... Args>
-void format_text(std::array<char, N>& to, fmt::format_string<Args...> f, Args&&... args) noexcept {
-  try {
-    const auto r = fmt::format_to_n(to.data(), N - 1, f, std::forward<Args>(args)...);
-    to[std::min(r.size, N - 1)] = '\0';
-  } catch (...) {
-    to[0] = '\0';
-  }
-}
 
 #if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
 constexpr bool kLockMemory = false;  // the sanitizers' shadow memory is terabytes of mappings
@@ -216,7 +200,7 @@ void Control::terminate(TerminateCode code) noexcept {
 }
 
 void Control::message(std::string_view text) noexcept {
-  copy_text(message_, text);
+  io::copy_fixed(message_, text);
 }
 
 void Control::spend(std::chrono::nanoseconds d) noexcept {
@@ -786,7 +770,7 @@ void Session::Clock::take_chgs(std::uint32_t k, bool in_time) noexcept {
         s->take_chg(*s->comm_);
       } else {
         std::array<char, kMessageCapacity> d;
-        format_text(d, "f1 of sample {} did not hand Chg over within its period", k);
+        io::format_fixed(d, "f1 of sample {} did not hand Chg over within its period", k);
         s->end_control(*s->comm_, TerminateCode::overrun, 0, d.data());
       }
     }
@@ -847,7 +831,7 @@ void Session::Clock::watchdog(std::uint32_t k, std::int64_t tick_ns) noexcept {
   last_published = 0;
   std::array<char, kMessageCapacity> d{};
   if (control_done.load(std::memory_order_acquire) != cycle) {
-    format_text(d, "the control cycle of sample {} was still running at the next tick", cycle);
+    io::format_fixed(d, "the control cycle of sample {} was still running at the next tick", cycle);
   } else if (simulated()) {
     // Simulated time: the computing a cycle charged with spend() must fit in its period. (In
     // real time the check above is the whole story: the cycle finished before this tick was
@@ -856,8 +840,8 @@ void Session::Clock::watchdog(std::uint32_t k, std::int64_t tick_ns) noexcept {
     const std::int64_t used =
         control_end_ns.load(std::memory_order_relaxed) - last_published_tick_ns;
     if (used <= period) return;
-    format_text(d, "the control cycle of sample {} took {:.3f} ms of a {:.3f} ms period", cycle,
-                static_cast<double>(used) * 1e-6, static_cast<double>(period) * 1e-6);
+    io::format_fixed(d, "the control cycle of sample {} took {:.3f} ms of a {:.3f} ms period",
+                     cycle, static_cast<double>(used) * 1e-6, static_cast<double>(period) * 1e-6);
   } else {
     return;
   }
@@ -949,17 +933,17 @@ bool Session::controlled_cycle(CommState& c, std::uint32_t k) noexcept {
   if (h.force.present && (c.chg.checking & kCheckForce) != 0) {
     if (h.force.frozen) {
       std::array<char, kMessageCapacity> d;
-      format_text(d, "the wrist sensor's reading {} repeated for {} samples", h.force.sequence,
-                  kForceFrozenSamples);
+      io::format_fixed(d, "the wrist sensor's reading {} repeated for {} samples", h.force.sequence,
+                       kForceFrozenSamples);
       end_control(c, TerminateCode::force_frozen, 0, d.data());
       return false;
     }
     if (h.force.saturated) {
       const math::Wrench& w = h.force.wrench;
       std::array<char, kMessageCapacity> d;
-      format_text(d, "wrist force ({:.1f}, {:.1f}, {:.1f}) N, torque ({:.2f}, {:.2f}, {:.2f}) N m",
-                  w.force_N.x, w.force_N.y, w.force_N.z, w.torque_N_m.x, w.torque_N_m.y,
-                  w.torque_N_m.z);
+      io::format_fixed(
+          d, "wrist force ({:.1f}, {:.1f}, {:.1f}) N, torque ({:.2f}, {:.2f}, {:.2f}) N m",
+          w.force_N.x, w.force_N.y, w.force_N.z, w.torque_N_m.x, w.torque_N_m.y, w.torque_N_m.z);
       end_control(c, TerminateCode::force_saturated, 0, d.data());
       return false;
     }
@@ -977,8 +961,8 @@ bool Session::controlled_cycle(CommState& c, std::uint32_t k) noexcept {
       j.flags |= kObservedPositionOut;
       if ((c.chg.checking & kCheckObservedPosition) != 0) {
         std::array<char, kMessageCapacity> d;
-        format_text(d, "joint {} measured at {:.5f} {}, limits [{:.5f}, {:.5f}]", i + 1, j.q,
-                    unit_of(m), m.lower, m.upper);
+        io::format_fixed(d, "joint {} measured at {:.5f} {}, limits [{:.5f}, {:.5f}]", i + 1, j.q,
+                         unit_of(m), m.lower, m.upper);
         end_control(c, TerminateCode::observed_position, static_cast<int>(i) + 1, d.data());
         return false;
       }
@@ -990,8 +974,8 @@ bool Session::controlled_cycle(CommState& c, std::uint32_t k) noexcept {
       j.flags |= kObservedVelocityOut;
       if ((c.chg.checking & kCheckObservedVelocity) != 0) {
         std::array<char, kMessageCapacity> d;
-        format_text(d, "joint {} measured at {:.4f} {}/s, maximum {:.4f}", i + 1, j.velocity,
-                    unit_of(m), top);
+        io::format_fixed(d, "joint {} measured at {:.4f} {}/s, maximum {:.4f}", i + 1, j.velocity,
+                         unit_of(m), top);
         end_control(c, TerminateCode::observed_velocity, static_cast<int>(i) + 1, d.data());
         return false;
       }
@@ -1084,8 +1068,8 @@ void Session::apply(CommState& c, const Chg& chg) noexcept {
       j.flags |= kTargetPositionOut;
       if ((chg.checking & kCheckTargetPosition) != 0 || !std::isfinite(target)) {
         std::array<char, kMessageCapacity> d;
-        format_text(d, "joint {} commanded to {:.5f} {}, limits [{:.5f}, {:.5f}]", number, target,
-                    unit_of(joint), joint.lower, joint.upper);
+        io::format_fixed(d, "joint {} commanded to {:.5f} {}, limits [{:.5f}, {:.5f}]", number,
+                         target, unit_of(joint), joint.lower, joint.upper);
         return end_control(c, TerminateCode::target_position, number, d.data());
       }
       target = std::clamp(target, joint.lower, joint.upper);  // never sent outside the limits
@@ -1104,8 +1088,8 @@ void Session::apply(CommState& c, const Chg& chg) noexcept {
       j.flags |= kTargetVelocityOut;
       if ((chg.checking & kCheckTargetVelocity) != 0 || !std::isfinite(rate)) {
         std::array<char, kMessageCapacity> d;
-        format_text(d, "joint {} commanded at {:.4f} {}/s, maximum {:.4f}", number, rate,
-                    unit_of(joint), top);
+        io::format_fixed(d, "joint {} commanded at {:.4f} {}/s, maximum {:.4f}", number, rate,
+                         unit_of(joint), top);
         return end_control(c, TerminateCode::target_velocity, number, d.data());
       }
       rate = top;  // arrives late rather than too fast
@@ -1130,7 +1114,7 @@ void Session::end_control(CommState& c, TerminateCode code, int joint,
   t.joint = joint;
   t.sample = c.k;
   t.time_s = static_cast<double>(c.tick_ns) * 1e-9;
-  copy_text(t.detail, detail);
+  io::copy_fixed(t.detail, detail);
   if (powers_down(code)) {
     driver_.set_power(false);
   } else {

@@ -1,4 +1,4 @@
-#include "rccx/rccl/sync.hpp"
+#include "rccx/rccl/motion_sync.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -43,29 +43,4 @@ constexpr bool reached(std::uint32_t a, std::uint32_t b) noexcept {
   return static_cast<std::int32_t>(a - b) >= 0;
 }
 
-/// A triple buffer: one writer publishes values without waiting, one reader takes the newest.
-template <class T>
-class Latest {
- public:
-  /// Writer: publishes v.
-  void publish(const T& v) noexcept {
-    buffers_[write_] = v;
-    write_ = static_cast<std::uint8_t>(
-        middle_.exchange(write_ | kFresh, std::memory_order_acq_rel) & kIndex);
-  }
-  /// Reader: the newest value into out; false when nothing new was published since last time.
-  bool take(T& out) noexcept {
-    if ((middle_.load(std::memory_order_acquire) & kFresh) == 0) return false;
-    read_ = static_cast<std::uint8_t>(middle_.exchange(read_, std::memory_order_acq_rel) & kIndex);
-    out = buffers_[read_];
-    return true;
-  }
-
- private:
-  static constexpr std::uint8_t kFresh = 4, kIndex = 3;
-  T buffers_[3]{};
-  std::atomic<std::uint8_t> middle_{1};
-  std::uint8_t write_ = 0, read_ = 2;
-};
-
 }  // namespace rccx::rtc::detail

@@ -1,4 +1,4 @@
-#include "rccx/rtc/sync.hpp"
+#include "rccx/rtc/doorbell.hpp"
 
 #include <linux/futex.h>
 #include <sys/syscall.h>
