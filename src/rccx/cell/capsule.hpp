@@ -1,5 +1,13 @@
-// The narrow phase of the collision check: the distance between two segments and between two
-// capsules (a segment swept by a sphere). Pure functions, noexcept, no allocation.
+// The narrow phase of the collision check: the distance between two segments, between two
+// capsules (a segment swept by a sphere), and between a capsule and a solid (a box or a
+// cylinder). Pure functions, noexcept, no allocation.
+//
+//   const cell::Capsule a{.p0_m = {0, 0, 0}, .p1_m = {0, 0, 0.3}, .radius_m = 0.05};
+//   const cell::Capsule b{.p0_m = {0.2, -0.1, 0.1}, .p1_m = {0.2, 0.1, 0.1}, .radius_m = 0.03};
+//   cell::capsule_distance(a, b).distance_m;             // 0.12 (m) between the surfaces
+//   const cell::Solid table =                            // 1 m x 1 m x 40 mm, top at z = 0
+//       cell::make_box({1, 1, 0.04}, math::Transform::translation(0, 0, -0.02));
+//   cell::capsule_solid_distance(a, table).distance_m;   // -0.05: a's end sphere is in it
 #pragma once
 
 #include <algorithm>

@@ -1,7 +1,13 @@
 // The constant description of a workcell: which robots stand where, on which clock, and what
 // else is in the world (a table, a circuit board) and which named places users refer to. Read
 // once from a cell file under cells/ (or built in code and checked with validate()); data only,
-// no sessions and no motion: the multi-robot session reads it.
+// no sessions and no motion: the multi-robot session (cell.hpp) reads it.
+//
+//   cell::CellModel model = cell::load_cell_file("cells/cvarl.json");   // throws CellFileError
+//   model.find_robot("puma")->base;                  // world <- the PUMA's base, m
+//   model.period(0);                                 // robot 0's sample period
+//   model.robots[0].base = math::Transform::translation(0.0, 1.2, 0.0);   // moved in code,
+//   cell::validate(model);                                                // so checked again
 //
 // One world frame per cell (m, rad, z up by convention); every robot's base, every object and
 // every frame is a transform from the world.

@@ -1,6 +1,14 @@
 // Safety between arms: every robot of a cell as capsules around the whole arm (links, joints,
 // hand, tool), and the cell's objects as solids, checked every sample.
 //
+//   std::vector<cell::RobotCapsules> robots;
+//   robots.emplace_back(puma, puma_radii, puma_base);          // robot_capsules.hpp
+//   robots.emplace_back(microbo, microbo_radii, microbo_base);
+//   cell::CollisionWorld world(std::move(robots), 0.01, {table});   // 10 mm margin, solids
+//   world.set_configuration(0, q);                  // every robot's next setpoint (rad / m)
+//   std::array<cell::Threat, 8> out;
+//   const std::size_t n = world.threats(out);       // pairs approaching within the margin
+//
 // The stop rule (threats()): a part of a robot within the margin plus the braking allowances
 // (set_allowance) of a part of another robot, or of a solid, is a threat when the two
 // approach: their distance now is less than at the last check (the capsules' before()). A

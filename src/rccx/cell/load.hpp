@@ -2,6 +2,10 @@
 // circle in Cartesian mode through a functional transform (inverse kinematics and a functional
 // evaluation every sample, collision checks between neighbours). What BM_CellCycle and
 // `rccx cell-load` measure.
+//
+//   cell::Cell c(cell::grid_cell(16, "puma560", 1.5, 7ms));   // 4 x 4 PUMAs 1.5 m apart
+//   cell::start_circles(c);                                    // starts c, queues every move
+//   c.wait_for(10s);                                           // simulated time
 #pragma once
 
 #include <chrono>

@@ -1,6 +1,12 @@
 // One robot as capsules in the world, the whole arm: its links, its joints, its base, its hand
 // and its tool, for the collision check between arms and against the cell's objects.
 //
+//   const std::vector<double> radii(model.dof(), 0.05);   // m, one per link (or one for all)
+//   cell::RobotCapsules robot(model, radii, base, shapes);  // base: world <- frame 0
+//   robot.update(q);                                     // rad / m; noexcept, no allocation
+//   for (const cell::Capsule& c : robot.capsules()) ...  // c.p0_m .. c.p1_m, c.radius_m
+//   robot.link_frame(model.dof() - 1);                   // world <- T6 at q
+//
 // Link i of a DH robot runs from the origin of frame i-1 to the origin of frame i: first d_i
 // along z_(i-1), then a_i along x_i (standard DH). Each non-zero part is one capsule (a
 // prismatic joint's d part is always one, since its length changes with q). A link with

@@ -1,13 +1,18 @@
 // A value one thread writes and any thread reads without a lock (a sequence lock): the writer
 // makes the counter odd, writes, makes it even; a reader copies and retries when the counter
-// was odd or changed meanwhile. Neither side blocks or allocates; the writer never waits. The
-// value is kept in atomic words so that the racing copy is defined behaviour (and
+// was odd or changed meanwhile. Neither side blocks or allocates; the writer never waits. What
+// the cell uses to hand one robot's tool frame, written by the control task each sample, to
+// another robot's trajectory generator (same thread) and to the planning level (move()).
+//
+//   cell::SeqLock<math::Transform> tool;             // any trivially copyable value
+//   tool.store(T6);                                  // the one writer, every sample
+//   math::Transform seen;
+//   if (tool.load(seen)) ...                         // any thread; false before the first store
+//
+// The value is kept in atomic words so that the racing copy is defined behaviour (and
 // ThreadSanitizer sees no race); release stores and acquire loads of the words order them
 // against the counter (plain moves on x86; fences would do as well, but ThreadSanitizer does
 // not model them).
-//
-// What the cell uses to hand one robot's tool frame, written by the control task each sample,
-// to another robot's trajectory generator (same thread) and to the planning level (move()).
 #pragma once
 
 #include <array>

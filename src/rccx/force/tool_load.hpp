@@ -1,7 +1,13 @@
-// A wrist sensor's reading turned into what contacts put on the tool (thesis 4.4.2: "compensation
-// would have to be made, of course, for gravity loading due to changes in the configuration of
-// the wrist"), the calibration of that compensation from readings at a few wrist orientations,
-// and the force transform from the sensor (T6) to the tool.
+// A wrist sensor's reading turned into what contacts put on the tool (thesis 4.4.2:
+// "compensation would have to be made, of course, for gravity loading due to changes in the
+// configuration of the wrist"), the calibration of that compensation from readings at a few
+// wrist orientations, and the force transform from the sensor (T6) to the tool.
+//
+//   std::vector<force::LoadSample> rest;           // 3+ wrist orientations, nothing touching
+//   rest.push_back({world_from_t6.R, how.force.wrench});   // N, N m, in T6
+//   const force::ToolLoad load = force::estimate_tool_load(rest);   // bias, kg, com in m
+//   const math::Wrench contact = force::external_wrench(load, world_from_t6.R, how.force.wrench);
+//   const math::Wrench at_tip = force::at_tool(t6_from_tool, contact);   // about the tool frame
 //
 // Signs: a sensor reading is the wrench the tool side exerts on the arm, about T6's origin in
 // T6's axes (rtc::ForceHow). A hanging tool of mass m reads its weight, force = R^T (0, 0, -m g)

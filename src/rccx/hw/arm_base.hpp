@@ -1,7 +1,14 @@
 // What every simulated arm shares, whatever moves its joints: the servo clock, each joint's
 // setpoint travelling to its goal, encoders and calibration, arm power and brakes, hard stops,
 // faults, the hand and the output bits. A derived arm supplies only the plant and its servo
-// (servo_tick), which runs while power is on.
+// (servo_tick), which runs while power is on:
+//
+//   class MyArm final : public hw::ArmBase {
+//    public:
+//     explicit MyArm(kin::RobotModel m) : ArmBase(std::move(m), {}) {}
+//    private:
+//     void servo_tick(double dt) noexcept override;   // dt s: move joints_[j].q, .qd toward
+//   };                                                // .setpoint, then clamp_to_stops()
 #pragma once
 
 #include <array>

@@ -3,6 +3,13 @@
 // relays the adapter did not reach (arm power, the hand, output bits: the RCU's C2 bus). A
 // driver written against these talks to an emulated controller or, behind the same
 // interfaces, a real one.
+//
+//   hw::Rcu rcu(model);                              // an emulated controller: the Relays
+//   hw::RcuBus bus(rcu);                             // and its Bus
+//   bus.sync(t_s);                                   // a sample begins at t_s, s
+//   if ((bus.in(hw::rcu_command_register(j)) & hw::kIbe) == 0)      // one exchange each
+//     bus.out(hw::rcu_command_register(j), hw::rcu::kGetPosition);
+//   rcu.set_power(true);                             // a relay, not the bus
 #pragma once
 
 #include <cstdint>

@@ -3,9 +3,16 @@
 // reports (SimulatedArm::wrist_wrench), plus what a real sensor adds - a bias (offset drift),
 // white noise, saturation at its measuring range - and a fault where the readings freeze (a
 // stalled sensor board, a cut cable: the last value repeats and the reading counter stops).
-// The numbers of the default spec are those of a small strain-gauge sensor of the ATI Mini45
-// class (SI-290-10: 290 N, 10 N m). Read by the communication task every sample: noexcept and
-// allocation-free after construction.
+//
+//   hw::ForceSensor sensor(*arm, {.noise_N = 0.0});  // arm: one with contact (MujocoArm)
+//   const hw::ForceReading r = sensor.read();        // N, N m about T6; r.saturated, sequence
+//   sensor.set_bias({{0.5, 0, 0}, {0, 0, 0}});       // the offset drifts, N and N m
+//   sensor.set_frozen(true);                         // the fault: the readings stop
+//
+// ServoDriver makes one for an arm that has a wrist (ServoDriver::force_sensor()). The default
+// spec is a small strain-gauge sensor of the ATI Mini45 class (SI-290-10: 290 N, 10 N m).
+// Read by the communication task every sample: noexcept and allocation-free after
+// construction.
 #pragma once
 
 #include <cstdint>

@@ -1,5 +1,8 @@
 // The effort each joint of a serial chain needs to hold a pose against gravity, from the link
 // masses and centres of mass of the robot file (JointDynamics) through the DH chain.
+//
+//   const hw::GravityModel gravity(kin::builtin_robot("puma560"));
+//   const kin::JointVector hold = gravity.load(q);   // q rad / m -> N m (N) per joint
 #pragma once
 
 #include <array>

@@ -4,6 +4,11 @@
 // zero gravity a joint moves at a speed proportional to the external effort on it (admittance
 // below) and stays where it is when released. Outside zero gravity external effort does nothing
 // (the servo is infinitely stiff).
+//
+//   hw::IdealArm arm(kin::builtin_robot("puma560"));   // or make_simulated_arm, plant ideal
+//   arm.command(0, {hw::ServoCommand::Kind::move, 30_deg, 10_deg});   // to 30 deg at 10 deg/s
+//   arm.advance_to(0.5);                               // 0.5 s of 1 ms servo ticks
+//   arm.true_position()[0];                            // 5 deg: exactly where the setpoint is
 #pragma once
 
 #include "rccx/hw/arm_base.hpp"

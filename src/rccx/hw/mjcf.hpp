@@ -4,6 +4,12 @@
 // six-axis force/torque sensor at T6, and the cell's table and objects as boxes. What MujocoArm
 // (mujoco_arm.hpp) loads; a person may load the same text in MuJoCo's viewer.
 //
+//   auto scene = std::make_shared<hw::Scene>(hw::scene_from_file(model));   // may be empty
+//   scene->boxes.push_back({"table", math::Transform::translation(0.5, 0, -0.22),
+//                           {0.4, 0.4, 0.02}});            // m; mass 0: fixed to the world
+//   const std::string xml = hw::make_mjcf(model, *scene);  // to look at it in MuJoCo
+//   auto arm = hw::make_simulated_arm(model, {.plant = hw::Plant::mujoco, .scene = scene});
+//
 // Frames. Body "link<i>" (i = 1 .. dof) carries joint i: its frame is DH frame i-1 moved by the
 // joint, Rot(z, q) or Trans(z, q), and the constant part of A_i, Rot(z, theta) Trans(z, d)
 // Trans(x, a) Rot(x, alpha), is where link<i+1> (or the site "t6") sits in it (the joint's

@@ -4,6 +4,13 @@
 // driver (rtc/servo_driver.hpp) is the only intended client; tests also read the plant's true
 // state to check what the servo really did.
 //
+//   using hw::ServoCommand;
+//   const auto arm = hw::make_simulated_arm(kin::builtin_robot("puma560"));   // PID servos
+//   arm->command(1, {ServoCommand::Kind::move, 90_deg, 20_deg});   // joint 2: 90 deg at 20 deg/s
+//   arm->advance_to(1.0);                            // 1000 servo ticks: t = 1 s
+//   const hw::JointReading r = arm->read(1);         // encoder counts and status bits
+//   arm->true_position()[1];                         // the plant itself, rad
+//
 // Time is whatever the caller says it is: advance_to(t) runs the servo ticks up to t, so the
 // same arm serves simulated time (deterministic) and real time (catch up on each read).
 // Every call is noexcept and allocation-free: the communication task makes them every sample.

@@ -1,6 +1,11 @@
 // Output that never throws and never hides a failure: error messages go to stderr with one
 // write(2) each (a closed or full stderr is ignored, as nothing else can be done), and
-// standard output is checked once at the end (a full disk or a closed pipe changes the exit code).
+// standard output is checked once at the end (a full disk or a closed pipe changes the exit
+// code).
+//
+//   io::eprint("{}: cannot read {}\n", program, file);   // one write(2), never throws
+//   fmt::print("{} samples\n", n);                        // stdout as usual, then at the end:
+//   if (std::string why; !io::flush_stdout(why)) return 1;   // something was lost: why says
 #pragma once
 
 #include <fmt/format.h>

@@ -1,10 +1,17 @@
 // Files that are replaced whole or not at all, and writes that never lose an error.
 //
-// write_file_atomically() (and AtomicFile for content written in pieces) writes to a temporary
-// file in the target's directory, flushes and fsyncs it, renames it over the target and fsyncs
-// the directory: a reader, a crash or a full disk sees the old file or the new one, never a
-// part. A write that fails (ENOSPC, EIO, a read-only directory) throws FileError, removes the
-// temporary file and leaves the target as it was.
+//   io::write_file_atomically("positions.json", text);   // the old file or the new, whole
+//   io::AtomicFile out("run.svg");                        // content written in pieces:
+//   out.write(head);
+//   out.write(body);                                      // throws FileError on ENOSPC, EIO ...
+//   out.commit();                                         // without it the target stays as it was
+//   const std::string back = io::read_file("positions.json");   // at most 64 MiB
+//
+// write_file_atomically() and AtomicFile write to a temporary file in the target's directory,
+// flush and fsync it, rename it over the target and fsync the directory: a reader, a crash or a
+// full disk sees the old file or the new one, never a part. A write that fails (ENOSPC, EIO, a
+// read-only directory) throws FileError, removes the temporary file and leaves the target as it
+// was.
 #pragma once
 
 #include <cstddef>

@@ -5,8 +5,9 @@
 //
 //   io::StopAwareInput buffer(STDIN_FILENO);
 //   std::istream in(&buffer);
-//   while (std::getline(in, line)) ...      // ends at end of input or on SIGINT / SIGTERM
-//   if (buffer.stopped()) ...                // and says which
+//   std::string line, problem;
+//   while (io::read_line(in, line, problem)) ...   // ends at end of input or on SIGINT / SIGTERM
+//   if (buffer.stopped()) ...                      // and says which
 #pragma once
 
 #include <array>

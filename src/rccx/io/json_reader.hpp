@@ -3,6 +3,12 @@
 // and so that an unknown key (a typo such as "upper_mm") is refused instead of silently ignored.
 // Errors are thrown as `Error` (each file kind has its own exception type), built from one
 // string. Header-only: the file readers include nlohmann/json themselves.
+//
+//   io::JsonObjectReader<kin::RobotFileError> r(joint_json, "puma560: joint 2");
+//   const std::string name = r.name("name");         // printable, at most 32 bytes
+//   const double a_m = r.number("a_m", 100.0);       // finite, |a_m| <= 100
+//   const double d_m = r.number_or("d_m", 0.0, 100.0);   // optional, 0 when missing
+//   r.no_unknown_keys();                             // "puma560: joint 2: unknown key ..."
 #pragma once
 
 #include <fmt/format.h>

@@ -8,6 +8,12 @@
 //   - text is UTF-8 without control characters (a NUL would cut it in C and SQLite).
 //
 // Every error is a ParseError whose message reads `WHAT: "TEXT" PROBLEM; WHAT TO DO`.
+//
+//   const double v = io::parse_number(text, "v: the speed", {1e-3, 250.0, "deg/s"});
+//   const std::chrono::nanoseconds p =                   // "28ms", "250us", or "28" (ms)
+//       io::parse_duration(text, "--period", io::BareUnit::milliseconds, 250us, 56ms);
+//   const std::size_t j = io::parse_joint(text, "j: the joint", model.dof());   // "2" -> 1
+//   io::check_name(name, "--name", 32);                  // letters, digits, _ - .
 #pragma once
 
 #include <chrono>

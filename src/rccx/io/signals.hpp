@@ -1,11 +1,14 @@
 // SIGINT, SIGTERM and SIGHUP (unless ignored, as under nohup) as requests to stop, for the
-// whole process. The handler only counts, keeps
-// the signal's number and posts a semaphore (all async-signal-safe). It is installed without
-// SA_RESTART, so that a call blocked on a full pipe or a terminal returns (EINTR) instead of
-// holding the program: rccx's own waits retry EINTR or end cleanly (io::write_all, the
-// futex doorbells, clock_nanosleep, StopAwareInput, SQLite). Whoever waits (a session's wait
-// functions, a console reading its input, a long import) looks at stop_count() and ends
-// cleanly within its own period.
+// whole process. The handler only counts, keeps the signal's number and posts a semaphore (all
+// async-signal-safe). It is installed without SA_RESTART, so that a call blocked on a full pipe
+// or a terminal returns (EINTR) instead of holding the program: rccx's own waits retry EINTR or
+// end cleanly. Whoever waits (a session's wait functions, a console reading its input, a long
+// import) looks at stop_count() and ends cleanly within its own period.
+//
+//   io::install_stop_handlers();                     // at the start of main()
+//   while (io::stop_count() == 0 && more) more = step();
+//   io::restore_stop_handlers();
+//   if (io::stop_count() > 0) return io::stop_exit_code();   // 130 for SIGINT, 143 SIGTERM
 //
 // Programs (the rccx commands) install the handlers for their whole run; a library user's
 // program gets them from rtc::Session only while it is in control (thesis 4.5.2, user_hangup).

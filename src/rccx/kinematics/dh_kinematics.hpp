@@ -2,6 +2,13 @@
 // matrices, the geometric Jacobian, and a damped-least-squares inverse that keeps every joint
 // within its limits. Slower than a closed form and it finds one solution (near the seed), but it
 // serves every robot a data file can describe.
+//
+//   const kin::DhKinematics k(kin::builtin_robot("stanford"), {.max_iterations = 200});
+//   const math::Transform T = k.forward(q);               // rad / m -> T6 in the base, m
+//   const kin::IkResult r = k.inverse(T, {.near = seed});  // the solution the seed leads to
+//   if (!r) kin::describe(r.status);                       // "no convergence: ..."
+//
+// make_kinematics() builds one for a model whose file says "solver": "dh".
 #pragma once
 
 #include "rccx/kinematics/kinematics.hpp"

@@ -1,6 +1,8 @@
 // One link of a DH chain applied to a frame, T <- T A_i, multiplied out (thesis eq. 3.3): A_i's
 // n is (ct, st, 0); its o and a mix v = T.o ct - T.n st with T.a through alpha. Shared by the
-// solvers' forward kinematics and the link frames of the collision capsules.
+// solvers' forward kinematics and the link frames of the collision capsules:
+//
+//   kin::apply_dh_link(T, ct, st, ca, sa, a_m, d_m);   // each link in turn, from T = base
 #pragma once
 
 #include "rccx/math/transform.hpp"

@@ -1,5 +1,9 @@
 // The robot files of robots/, compiled in by CMake (cmake/embed_robots.cmake) so that the
-// library and the rccx command find them wherever they are installed.
+// library and the rccx command find them wherever they are installed. Programs reach them
+// through builtin_robot() and builtin_robot_names() (robot_model.hpp), which do this:
+//
+//   for (const detail::EmbeddedRobot& r : detail::embedded_robots())   // "puma560.json", ...
+//     if (r.file_name == "puma560.json") return parse_robot(r.text, "robots/puma560.json");
 #pragma once
 
 #include <span>

@@ -1,5 +1,11 @@
 // A joint vector of up to kMaxJoints values (rad for revolute joints, m for prismatic ones),
 // held by value so that the sample loop can pass and return it without touching the heap.
+//
+//   kin::JointVector q{0.0, 45_deg, -180_deg, 0.0, 45_deg, 0.0};   // the PUMA's ready pose, rad
+//   kin::JointVector v(model.dof());                                  // dof() zeros
+//   q[1] += 5_deg;
+//   for (double& x : v) x = 0.1;                                      // rad/s, say
+//   std::span<const double> values = q.span();                        // q.size() of them
 #pragma once
 
 #include <algorithm>

@@ -2,6 +2,13 @@
 // Jacobian questions. All calls are noexcept and allocation-free so that the trajectory
 // generator may call them every sample; failures come back as an IkStatus, never as an
 // exception (the planning level turns them into messages).
+//
+//   const auto k = kin::make_kinematics(kin::builtin_robot("puma560"));   // the closed form
+//   const math::Transform T = k->forward(q);                // q rad / m -> T6 in the base, m
+//   const kin::IkResult r = k->inverse(T, {.configuration = k->find_configuration("lun")});
+//   if (!r) fmt::print("{}\n", kin::describe(r.status));     // "out of reach: ..."
+//   const kin::IkSolutions all = k->inverse_all(T);          // one per configuration
+//   const kin::Jacobian J = k->jacobian(q);                  // 6 x dof: m/s, rad/s per joint
 #pragma once
 
 #include <Eigen/Core>

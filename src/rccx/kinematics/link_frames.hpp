@@ -1,5 +1,11 @@
 // Every link frame of a standard DH chain, not only T6: what collision capsules and other
 // per-link geometry need each sample. Noexcept and allocation-free, like forward().
+//
+//   const kin::DhChain chain(model);                 // once: the chain's constants
+//   std::array<math::Transform, kin::kMaxJoints> frames;
+//   kin::link_frames(chain, q, frames, base);        // each sample; q rad / m
+//   frames[0];                                       // world <- frame 1 (base A1), m
+//   frames[model.dof() - 1];                         // world <- T6
 #pragma once
 
 #include <array>

@@ -2,6 +2,12 @@
 // (thesis section 3.4), their limits and encoder resolution, and which solver serves it. It is
 // read once from a data file under robots/ and never changes while a program runs; everything
 // computed from it per call lives in the solvers (the Model / Data split of Pinocchio).
+//
+//   const kin::RobotModel puma = kin::builtin_robot("puma560");   // robots/, compiled in
+//   const kin::RobotModel mine = kin::load_robot_file("arm.json");   // throws RobotFileError
+//   puma.dof();                                      // 6
+//   puma.joints[1].upper;                            // 225 deg, in rad (m for prismatic)
+//   puma.within_limits(puma.ready());                // true
 #pragma once
 
 #include <array>

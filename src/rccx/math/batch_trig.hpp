@@ -2,6 +2,11 @@
 // of each per solution with no dependency between them, so they are computed side by side:
 // with SLEEF's AVX2 kernels (3.5 ulp at most) when the processor has AVX2 and FMA, with glibc
 // otherwise. The choice is made once, at run time, so one binary runs on any x86-64.
+//
+//   const double theta_rad[4] = {q[0], q[3], q[4], q[5]};
+//   double s[4], c[4];
+//   math::sincos4(theta_rad, s, c);     // s[i] = sin(theta_rad[i]), c[i] = cos(theta_rad[i])
+//   math::atan2_4(y, x, angle_rad);     // four atan2(y[i], x[i]), in [-pi, pi]
 #pragma once
 
 namespace rccx::math {

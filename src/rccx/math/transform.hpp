@@ -2,8 +2,16 @@
 // columns n (normal), o (orientation), a (approach) and p (position) of a 4x4 matrix whose last
 // row is 0 0 0 1. Lengths are in metres, angles in radians.
 //
-// These are small value types written out by hand rather than Eigen types: the kinematics and
-// the trajectory generator multiply a few of them per sample, and the closed-form solvers read
+//   using namespace rccx::math::literals;
+//   const math::Transform down{math::Rot3::rot_x(180_deg), {325_mm, 0.0, 250_mm}};
+//   const math::Transform T = base * down * math::Transform::translation(0, 0, 0.1);
+//   const math::Vec3 tip = T * math::Vec3{0, 0, 0.02};   // a point of frame T, in base's m
+//   const math::Transform back = T.inverse_times(goal);  // T^-1 goal
+//   const math::DriveTransform drive(T, goal);
+//   const math::Transform half_way = drive.at(0.5);      // Paul's drive, r in [0, 1]
+//
+// Small value types written out by hand rather than Eigen types: the kinematics and the
+// trajectory generator multiply a few of them per sample, and the closed-form solvers read
 // individual elements by name (n.x, a.z ...) exactly as the thesis's equations do.
 #pragma once
 

@@ -1,5 +1,11 @@
-// Unit literals. Everything inside rccx is SI (m, rad, s); these literals let code
-// written the 1986 way (millimetres, degrees) say so where the number is written.
+// Unit literals. Everything inside rccx is SI (m, rad, s); these literals let code written the
+// 1986 way (millimetres, degrees) say so where the number is written.
+//
+//   using namespace rccx::math::literals;
+//   const double reach = 325_mm;     // 0.325 (m)
+//   const double turn = 90_deg;      // 1.5708 (rad)
+//   const double period = 28_ms;     // 0.028 (s); _s takes a decimal point: 2.0_s
+//   math::rad_to_deg(turn);          // 90
 #pragma once
 
 #include <numbers>

@@ -2,6 +2,11 @@
 // same load expressed at another frame's origin and in its axes. A wrist sensor reports the
 // wrench in its own frame; the tool tip, the world or any frame of a position equation is one
 // call away.
+//
+//   const math::Wrench at_t6{{0, 0, -10}, {0, 0, 0}};    // N, N m, about T6 in T6's axes
+//   const math::Wrench at_tool = math::transform_wrench(t6_from_tool.inverse(), at_t6);
+//   const math::Wrench tool_weight = math::weight_wrench(world_from_t6.R, 0.4, {0, 0, 0.05});
+//   at_t6 - tool_weight;                                  // what is left: contacts (0.4 kg, m)
 #pragma once
 
 #include <array>

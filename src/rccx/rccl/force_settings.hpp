@@ -3,6 +3,13 @@
 // and nextmove, sensor-driven), and compliance along chosen axes of the tool frame (RCCL's
 // comply / lock). Plain values: each motion request carries a copy, as it does the speeds.
 //
+//   arm.set_guard({.kind = rccl::ForceGuard::Kind::along, .axis = 2, .threshold = 5.0});
+//   arm.waitfor(arm.move(below).end());              // stops once fz reaches 5 N
+//   arm.set_guard({});
+//   arm.set_compliance({.axes = 1U << 2, .force = {0, 0, 10.0}});   // press 10 N along z
+//   arm.waitfor(arm.move(along).end());              // slides, holding the force
+//   arm.set_compliance({});
+//
 // Axes are those of the motion's tool frame F = T6 TOOL: 0..2 forces along x y z (N), 3..5
 // torques about them (N m). Forces are the ones the tool exerts on what it touches: pressing
 // the tool's z axis onto a table is a positive fz.

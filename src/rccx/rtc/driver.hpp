@@ -1,7 +1,12 @@
 // The communication task's side of one robot: read every joint into How, send this sample's
-// joint commands, hold, power. One Driver per robot kind: `ServoDriver` for the simulated
-// servo arms of rccx::hw; the Microbo's register-protocol driver will sit behind the same
-// interface. The communication task calls these every sample: noexcept, no allocation.
+// joint commands, hold, power. One Driver per robot kind: ServoDriver for the simulated servo
+// arms of rccx::hw, MicroboDriver for the Microbo's RCU. The communication task calls these
+// every sample: noexcept, no allocation.
+//
+//   rtc::ServoDriver driver(*arm);                   // a Driver
+//   rtc::Session session(driver, {.period = 10ms});  // calls it every sample:
+//   driver.read(t_s, how);                           //   the arm into How: q rad / m, flags
+//   driver.send(commands);                           //   checked targets, rad / m and rad/s
 #pragma once
 
 #include <array>

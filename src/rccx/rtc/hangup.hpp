@@ -2,6 +2,9 @@
 // rccx::io::signals only counts and posts a semaphore; the communication task sees the count
 // change at its next tick and ends the session with `user_interrupt`, unless the session has a
 // hang-up handler of the user's, which a watcher thread then runs (never the sample loop).
+//
+//   session.set_hangup_handler([](rtc::Session& s) { s.terminate(); });  // before control()
+//   session.control(f1, f2);            // calls detail::register_for_hangup(this)
 #pragma once
 
 #include <cstdint>

@@ -2,6 +2,12 @@
 // Driver interface, talking to the RCU only through a Bus (register bytes) and its Relays, so
 // that the emulator (hw::RcuBus) or a real bus adapter may sit below it.
 //
+//   const kin::RobotModel model = kin::builtin_robot("microbo");
+//   hw::Rcu rcu(model);                              // the emulated RCU, also the Relays
+//   hw::RcuBus bus(rcu);                             // 75 us a bus exchange
+//   rtc::MicroboDriver driver(model, bus, rcu);
+//   rtc::Session session(driver, {.period = 28ms});  // about 10 ms of bus traffic a sample
+//
 // Each sample, per joint: GET STATUS, GET POSITION, then SET TARGET and SET SPEED by the
 // synchronous "follow" scheme: with Xd the position the joint should reach at the end of the
 // next period and Xm the measured one, the target X = Xd + (Xd - Xm) stays far enough ahead

@@ -3,6 +3,11 @@
 // of emulated time. It shows what the thesis showed (4.4.3): raw targets make the vendor's
 // joint law decelerate at every target, the follow scheme tracks smoothly. Used by the tests,
 // example 03 and docs/MICROBO.md.
+//
+//   const rtc::RampTrial trial{.scheme = rtc::TargetScheme::raw, .speed = 0.1};  // d3, 100 mm/s
+//   const rtc::RampResult r = rtc::run_ramp_trial(kin::builtin_robot("microbo"), trial);
+//   r.max_error_counts();                            // |Xd - Xm|, encoder counts
+//   r.amplitude_at(1.0 / trial.period_s);            // m/s of ripple at the sample frequency
 #pragma once
 
 #include <cstddef>

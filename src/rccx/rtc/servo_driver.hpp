@@ -1,7 +1,12 @@
 // The Driver for rccx::hw's simulated servo arms (the PUMA with its PID servos, the ideal arm
-// for any model): encoder counts to joint values, speeds from encoder differences, commands to
-// servo goals. The arm is advanced to the sample time on each read, so it
-// runs in simulated time and real time alike.
+// for any model, MuJoCo): encoder counts to joint values, speeds from encoder differences,
+// commands to servo goals. The arm is advanced to the sample time on each read, so it runs in
+// simulated time and real time alike.
+//
+//   const auto arm = hw::make_simulated_arm(kin::builtin_robot("puma560"));
+//   rtc::ServoDriver driver(*arm);                   // the arm must outlive it
+//   rtc::Session session(driver, {.period = 10ms, .clock = rtc::ClockKind::simulated});
+//   if (hw::ForceSensor* s = driver.force_sensor()) s->set_bias({{0.5, 0, 0}, {0, 0, 0}});
 #pragma once
 
 #include <array>

@@ -3,6 +3,13 @@
 // an RCU (and names no other plant), else a servo arm (MuJoCo when the file or the options say
 // "mujoco", the PUMA's PID servos, or the ideal servo for any robot file). What the control
 // programs, the examples and the compat layer all start from.
+//
+//   rtc::SimulatedRobot robot(kin::builtin_robot("puma560"), {.log = "run.csv"});  // 10 ms
+//   rccl::Manipulator arm(*robot.session);           // or robot.session->control(f1, f2)
+//   arm.start();
+//   arm.waitfor(arm.move(arm.park()).end());         // simulated time runs while waiting
+//   robot.push(1, 20.0);                             // a hand pushes joint 2, N m
+//   const std::string problem = robot.finish();      // closes; run.csv in place, "" if whole
 #pragma once
 
 #include <chrono>

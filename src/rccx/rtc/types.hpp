@@ -2,6 +2,14 @@
 // communication task read it this sample; `Chg`, the commands the control functions hand it;
 // and the terminate codes that say why a control session ended. Plain values, fixed size:
 // they are copied between the two tasks every sample and must never touch the heap.
+//
+//   session.control({}, [](rtc::Control& c) {              // f2, every sample
+//     const rtc::How& how = c.how();                         // read at the sample's start
+//     c.chg().posvel(1, how.joint[1].range + 0.001);         // joint 2: 1 mrad on, next sample
+//     if (how.time_s > 2.0) c.terminate();                   // s since the session opened
+//   });
+//   const rtc::Termination t = session.wait_terminated(5s);  // t.code: user_request
+//   rtc::print_terminate_code(t);                            // why control ended
 #pragma once
 
 #include <array>

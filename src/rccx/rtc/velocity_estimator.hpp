@@ -1,6 +1,10 @@
 // Joint speeds from encoder positions: the difference over at least a window of time, so that
 // one count of quantisation is a small speed even at a 0.25 ms period. Fixed size, no
 // allocation: the communication task updates it every sample.
+//
+//   rtc::VelocityEstimator velocity;                 // a driver's, one for all joints
+//   const kin::JointVector v = velocity.update(t_s, q);   // q rad / m read at t_s -> rad/s, m/s
+//   velocity.restart(i, q[i]);                       // joint i's counts jumped (calibration)
 #pragma once
 
 #include <array>

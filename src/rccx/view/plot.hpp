@@ -1,6 +1,10 @@
 // `rccx plot`: the standard plots of a recorded run as one SVG, for reports and docs, without a
 // browser: the joints (commanded and measured), the tool path in the plane it moves in most,
 // the speed along the path, and the path error (the measured tool from the commanded path).
+//
+//   const view::RunLog log = view::load_run_log("run.csv");   // a session's CSV log
+//   const std::string svg = view::plot_svg(log, kin::builtin_robot("puma560"), "run.csv");
+//   io::write_file_atomically("run.svg", svg);                // about 1200 x 900 px
 #pragma once
 
 #include <string>
