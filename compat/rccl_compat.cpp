@@ -64,6 +64,19 @@ int fail(int code, std::string_view text, Say say) noexcept {
   return code;
 }
 
+ArmSession::ArmSession(kin::RobotModel model, const rtc::SimulatedRobotOptions& options)
+    : robot(std::move(model), options), arm(*robot.session) {}
+
+void Refusals::note(int code) noexcept {
+  if (code != RTC_OK && ++count == 1) {
+    first_code = code;
+    try {
+      first = rtc_error_message();
+    } catch (...) {
+    }
+  }
+}
+
 namespace {
 
 /// `completed` also waits for the measured arm to stop (every joint under this fraction of its
@@ -73,19 +86,19 @@ constexpr double kSettledSpeedFraction = 0.002;
 /// ... but at most this long after the last motion ended (an arm that keeps trembling).
 constexpr double kSettleTimeout_s = 1.0;
 
-bool arm_settled(State& s, bool ended) noexcept {
+bool arm_settled(ArmSession& a, bool ended) noexcept {
   if (!ended) {
-    s.ended_at_sample = 0;
+    a.ended_at_sample = 0;
     return false;
   }
-  if (!s.robot || !s.controlling || !s.robot->session->controlling()) return true;
-  const rtc::Session& session = *s.robot->session;
+  if (!a.controlling || !a.robot.session->controlling()) return true;
+  const rtc::Session& session = *a.robot.session;
   const rtc::How how = session.how();
-  if (s.ended_at_sample == 0) s.ended_at_sample = std::max<std::uint64_t>(how.sample, 1);
-  const double waited_s = static_cast<double>(how.sample - s.ended_at_sample) *
+  if (a.ended_at_sample == 0) a.ended_at_sample = std::max<std::uint64_t>(how.sample, 1);
+  const double waited_s = static_cast<double>(how.sample - a.ended_at_sample) *
                           std::chrono::duration<double>(session.period()).count();
   if (waited_s >= kSettleTimeout_s) return true;
-  const auto& joints = s.arm->kinematics().model().joints;
+  const auto& joints = a.arm.kinematics().model().joints;
   for (std::size_t j = 0; j < how.dof && j < joints.size(); ++j) {
     if (std::abs(how.joint[j].velocity) > kSettledSpeedFraction * joints[j].max_velocity) {
       return false;
@@ -100,7 +113,7 @@ void mark_session_for_task() noexcept {
   state().opened_for_task = true;
 }
 bool session_open() noexcept {
-  return state().robot != nullptr;
+  return state().arm_session.has_value();
 }
 
 void refresh() noexcept {
@@ -111,11 +124,12 @@ void refresh() noexcept {
     });
     box->shown->end = box->queued.empty() ? 1 : 0;
   }
-  if (s.arm) {
-    completed = arm_settled(s, s.arm->happened(rc::Manipulator::completed())) ? 1 : 0;
-  } else if (s.cell) {
+  if (s.arm_session) {
+    ArmSession& a = *s.arm_session;
+    completed = arm_settled(a, a.arm.happened(rc::Manipulator::completed())) ? 1 : 0;
+  } else if (s.cell_session) {
     completed = 1;
-    for (const auto& [name, m] : s.manips) {
+    for (const auto& [name, m] : s.cell_session->manips) {
       if (!m->arm->happened(rc::Manipulator::completed())) completed = 0;
     }
   } else {
@@ -125,19 +139,19 @@ void refresh() noexcept {
 
 namespace {
 
-std::string motion_name(const State& s, std::uint64_t id) {
-  const auto it = s.motion_names.find(id);
-  return it == s.motion_names.end() ? fmt::format("motion {}", id)
+std::string motion_name(const ArmSession& a, std::uint64_t id) {
+  const auto it = a.motion_names.find(id);
+  return it == a.motion_names.end() ? fmt::format("motion {}", id)
                                     : fmt::format("motion {} (to {})", id, it->second);
 }
 
 /// The arm's measured T6 (m, rad).
-math::Transform measured_t6(const State& s) {
-  return s.arm->kinematics().forward(s.robot->session->how().q());
+math::Transform measured_t6(const ArmSession& a) {
+  return a.arm.kinematics().forward(a.robot.session->how().q());
 }
 
 /// Control has ended by itself: RTC_E_TERMINATED, printed the first time only.
-int control_ended(std::string_view call);
+int control_ended(ArmSession& a, std::string_view call);
 
 /// The configuration `asked` (letters or words) in the robot's names, letters not given taken
 /// from `present`. Throws std::invalid_argument naming the robot's letters.
@@ -209,59 +223,52 @@ std::string configuration_letters(const kin::Kinematics& k, std::string_view ask
 }
 
 /// Settings, configuration and the queue's bookkeeping for one move() or stop().
-void apply_settings(State& s) {
-  s.arm->set_mode(s.settings.mode);
-  s.arm->set_velocity(s.settings.translation_m_per_s, s.settings.rotation_rad_per_s);
-  s.arm->set_segment_time(s.settings.segment_time_s);
-  s.arm->set_transition_time(s.settings.transition_time_s);
-  s.arm->set_guard(s.settings.guard);
-  s.arm->set_compliance(s.settings.compliance);
+void apply_settings(ArmSession& a, const rc::MotionSettings& settings) {
+  a.arm.set_mode(settings.mode);
+  a.arm.set_velocity(settings.translation_m_per_s, settings.rotation_rad_per_s);
+  a.arm.set_segment_time(settings.segment_time_s);
+  a.arm.set_transition_time(settings.transition_time_s);
+  a.arm.set_guard(settings.guard);
+  a.arm.set_compliance(settings.compliance);
   // setconf() is for joint moves, which may change configuration; a Cartesian line keeps the
   // arm's (the manual's setconf letters stay asked for the joint moves that follow).
-  if (s.configuration.empty() || s.settings.mode == rc::Mode::cartesian) {
-    s.arm->set_configuration("");
+  if (a.configuration.empty() || settings.mode == rc::Mode::cartesian) {
+    a.arm.set_configuration("");
   } else {
-    const kin::Kinematics& k = s.arm->kinematics();
+    const kin::Kinematics& k = a.arm.kinematics();
     const std::string present(
-        k.configuration_names()[k.configuration_of(s.robot->session->how().q()).index]);
-    s.arm->set_configuration(configuration_letters(k, s.configuration, present));
+        k.configuration_names()[k.configuration_of(a.robot.session->how().q()).index]);
+    a.arm.set_configuration(configuration_letters(k, a.configuration, present));
   }
 }
 
 /// The checks every motion call makes; RTC_OK or the error (printed).
 int check_can_move(State& s, const std::string& what) {
-  if (s.cell) {
+  if (s.cell_session) {
     return fail(RTC_E_SEQUENCE,
                 fmt::format("{}: a cell is open: name the robot, mnp_move(robot, p)", what),
                 Say::print);
   }
-  if (!s.arm || !s.controlling) {
+  if (!s.arm_session || !s.arm_session->controlling) {
     return fail(RTC_E_SEQUENCE,
                 fmt::format("{}: call rccl_open() and rccl_control() before it", what), Say::print);
   }
-  if (!s.robot->session->controlling()) return control_ended(what);
+  if (!s.arm_session->robot.session->controlling()) return control_ended(*s.arm_session, what);
   return RTC_OK;
 }
 
 /// A 1986 program does not look at move()'s result: rccl_close() will tell.
-void note_refusal(int code) {
+void note_refusal(int code) noexcept {
   State& s = state();
-  if (code != RTC_OK && s.robot && ++s.refused_moves == 1) {
-    s.first_refusal_code = code;
-    try {
-      s.first_refusal = rtc_error_message();
-    } catch (...) {
-    }
-  }
+  if (s.arm_session) s.arm_session->refusals.note(code);
 }
 
-int control_ended(std::string_view call) {
-  State& s = state();
-  const Say say = s.told_ended ? Say::quiet : Say::print;
-  s.told_ended = true;
+int control_ended(ArmSession& a, std::string_view call) {
+  const Say say = a.told_ended ? Say::quiet : Say::print;
+  a.told_ended = true;
   return fail(RTC_E_TERMINATED,
               fmt::format("{}: {}; rccl_close() the session", call,
-                          describe_end(s.robot->session->termination())),
+                          describe_end(a.robot.session->termination())),
               say);
 }
 
@@ -285,7 +292,7 @@ PositionBox* position_of(POS_PTR p, const char* call) {
 }
 
 /// The box behind `park` for the open session (built on first use).
-PositionBox& park_position(State& s) {
+PositionBox& park_position(State& s, const ArmSession& a) {
   auto it = s.positions.find(&park_box());
   if (it == s.positions.end()) {
     auto box = std::make_unique<PositionBox>();
@@ -293,7 +300,7 @@ PositionBox& park_position(State& s) {
     box->shown = &park_box();
     it = s.positions.emplace(&park_box(), std::move(box)).first;
   }
-  it->second->joints = s.arm->park();
+  it->second->joints = a.arm.park();
   return *it->second;
 }
 
@@ -349,8 +356,10 @@ void read_equation(std::va_list ap, EquationArgs& a) noexcept {
 
 /// The result of a C transform's function, the planning side: `nextmove` set by the program.
 void act_on_nextmove(State& s) noexcept {
-  if (s.arm) s.arm->generator().request_next();
-  for (const auto& [name, m] : s.manips) m->arm->generator().request_next();
+  if (s.arm_session) s.arm_session->arm.generator().request_next();
+  if (s.cell_session) {
+    for (const auto& [name, m] : s.cell_session->manips) m->arm->generator().request_next();
+  }
 }
 
 TRSF eq_mark{};
@@ -370,7 +379,7 @@ std::string describe_end(const rtc::Termination& t) {
 
 bool rccl_session_open() noexcept {
   const State& s = state();
-  return s.robot != nullptr || s.cell != nullptr;
+  return s.arm_session || s.cell_session;
 }
 
 void take_nextmove() noexcept {
@@ -405,18 +414,17 @@ void show_motion_codes(rc::Manipulator& arm,
   }
 }
 
-void report_failures() {
-  State& s = state();
+void report_failures(ArmSession& a) {
   // Ended events of nextmove, and failures, set POS.code of the motion's position.
-  show_motion_codes(*s.arm, s.motion_boxes);
-  const std::vector<rc::MotionEvent>& f = s.arm->failures();
+  show_motion_codes(a.arm, a.motion_boxes);
+  const std::vector<rc::MotionEvent>& f = a.arm.failures();
   std::size_t cancelled = 0;
-  for (; s.failures_seen < f.size(); ++s.failures_seen) {
-    const rc::MotionEvent& e = f[s.failures_seen];
+  for (; a.failures_seen < f.size(); ++a.failures_seen) {
+    const rc::MotionEvent& e = f[a.failures_seen];
     if (e.kind == rc::EventKind::failed) {
       fail(RTC_E_MOTION,
            fmt::format("{} failed at t = {:.3f} s: {}; the arm stops where it is",
-                       motion_name(s, e.id), e.t_s, e.message()),
+                       motion_name(a, e.id), e.t_s, e.message()),
            Say::print);
     } else {
       ++cancelled;
@@ -563,17 +571,17 @@ POS_PTR makeposition(const char* name, ...) {
 int rccl_open(const char* robot, double period_ms) {
   return guarded("rccl_open", Say::quiet, RTC_E_ROBOT, [&] {
     State& s = state();
-    if (s.robot && s.opened_for_task) {
+    if (s.arm_session && s.opened_for_task) {
       // pumatask() opening the session main() opened for it: as it asks, if nothing has moved.
-      if (!s.motion_names.empty()) return RTC_OK;
+      if (!s.arm_session->motion_names.empty()) return RTC_OK;
       s.opened_for_task = false;
       if (const int code = rccl_close(0); code != RTC_OK) return code;
     }
-    if (s.robot) {
+    if (s.arm_session) {
       return fail(RTC_E_SEQUENCE, "rccl_open: a session is open already; rccl_close() it first",
                   Say::quiet);
     }
-    if (s.cell) {
+    if (s.cell_session) {
       return fail(RTC_E_SEQUENCE, "rccl_open: a cell is open; rcclRelease() it first", Say::quiet);
     }
     if (rtc_session_open()) {
@@ -591,23 +599,11 @@ int rccl_open(const char* robot, double period_ms) {
     }
     rtc::SimulatedRobotOptions options;  // simulated time; the log from RCCX_LOG (the session)
     options.period = std::chrono::nanoseconds(std::llround(period_ms * 1e6));
-    auto robot_sim = std::make_unique<rtc::SimulatedRobot>(choose_robot(robot), options);
-    auto arm = std::make_unique<rc::Manipulator>(*robot_sim->session);
-    s.robot = std::move(robot_sim);
-    s.arm = std::move(arm);
-    s.controlling = false;
-    s.told_ended = false;
-    s.failures_seen = 0;
-    s.refused_moves = 0;
-    s.first_refusal.clear();
-    s.motion_names.clear();
-    s.motion_boxes.clear();
-    s.displacement = math::Transform::identity();
-    s.configuration.clear();  // letters of the last session's robot
+    const ArmSession& a = s.arm_session.emplace(choose_robot(robot), options);
     t6_box().c.age = -1;
     nextmove = 0;
-    park_position(s);
-    to_c(measured_t6(s), t6_box().c);
+    park_position(s, a);
+    to_c(measured_t6(a), t6_box().c);
     refresh();
     return RTC_OK;
   });
@@ -616,14 +612,17 @@ int rccl_open(const char* robot, double period_ms) {
 int rccl_control(void) {
   return guarded("rccl_control", Say::quiet, RTC_E_INTERNAL, [] {
     State& s = state();
-    if (!s.arm) return fail(RTC_E_SEQUENCE, "rccl_control: call rccl_open() first", Say::quiet);
-    if (s.controlling && s.opened_for_task) return RTC_OK;
-    if (s.controlling) {
+    if (!s.arm_session) {
+      return fail(RTC_E_SEQUENCE, "rccl_control: call rccl_open() first", Say::quiet);
+    }
+    ArmSession& a = *s.arm_session;
+    if (a.controlling && s.opened_for_task) return RTC_OK;
+    if (a.controlling) {
       return fail(RTC_E_SEQUENCE, "rccl_control: the trajectory generator runs already",
                   Say::quiet);
     }
-    s.arm->start();
-    s.controlling = true;
+    a.arm.start();
+    a.controlling = true;
     refresh();
     return RTC_OK;
   });
@@ -632,32 +631,29 @@ int rccl_control(void) {
 int rccl_close(int power_off) {
   return guarded("rccl_close", Say::quiet, RTC_E_INTERNAL, [&] {
     State& s = state();
-    if (!s.robot) return fail(RTC_E_SEQUENCE, "rccl_close: no session is open", Say::quiet);
+    if (!s.arm_session) return fail(RTC_E_SEQUENCE, "rccl_close: no session is open", Say::quiet);
     // Whatever happens below, the session is gone afterwards.
     struct Closer {
       State& s;
       ~Closer() {
-        s.arm.reset();
-        s.robot.reset();
+        s.arm_session.reset();
         // Motions still queued will never end now.
         for (auto& [key, box] : s.positions) box->queued.clear();
         if (auto it = s.positions.find(&park_box()); it != s.positions.end()) {
           it->second->joints.reset();  // the next session's robot has its own park
         }
-        s.controlling = false;
-        s.motion_names.clear();
-        s.motion_boxes.clear();
         refresh();
       }
     } closer{s};
 
+    ArmSession& a = *s.arm_session;
     int code = RTC_OK;
     std::string why;
-    if (s.controlling) report_failures();
+    if (a.controlling) report_failures(a);
     // The motions have ended: let the arm come to rest before control stops (bounded).
-    if (s.controlling && s.robot->session->controlling() &&
-        s.arm->happened(rc::Manipulator::completed())) {
-      rtc::Session& session = *s.robot->session;
+    if (a.controlling && a.robot.session->controlling() &&
+        a.arm.happened(rc::Manipulator::completed())) {
+      rtc::Session& session = *a.robot.session;
       refresh();
       while (completed == 0 && session.controlling()) {
         session.wait_for(session.period());
@@ -665,8 +661,8 @@ int rccl_close(int power_off) {
       }
     }
     const rtc::Termination t =
-        s.controlling ? s.arm->stop_control() : s.robot->session->termination();
-    const std::vector<rc::MotionEvent>& failures = s.arm->failures();
+        a.controlling ? a.arm.stop_control() : a.robot.session->termination();
+    const std::vector<rc::MotionEvent>& failures = a.arm.failures();
     if (t.ended()) {
       code = RTC_E_TERMINATED;
       why = describe_end(t);
@@ -674,16 +670,16 @@ int rccl_close(int power_off) {
       const rc::MotionEvent& first = failures.front();
       code = RTC_E_MOTION;
       why = fmt::format("{} motion(s) failed or were cancelled during the session; first {} {}{}{}",
-                        failures.size(), motion_name(s, first.id), rc::to_string(first.kind),
+                        failures.size(), motion_name(a, first.id), rc::to_string(first.kind),
                         first.message().empty() ? "" : ": ", first.message());
-    } else if (s.refused_moves > 0) {
-      code = s.first_refusal_code;
+    } else if (a.refusals.count > 0) {
+      code = a.refusals.first_code;
       why = fmt::format(
           "{} call(s) to queue a motion were refused during the session; the "
           "first: {}",
-          s.refused_moves, s.first_refusal);
+          a.refusals.count, a.refusals.first);
     }
-    s.robot->session->close(power_off != 0);
+    a.robot.session->close(power_off != 0);
     return code == RTC_OK ? RTC_OK : fail(code, "rccl_close: " + why, Say::quiet);
   });
 }
@@ -742,9 +738,9 @@ int setconf(const char* configuration) {
   return guarded("setconf", Say::print, RTC_E_ARGUMENT, [&] {
     State& s = state();
     const std::string asked = configuration != nullptr ? configuration : "";
-    if (s.arm && !asked.empty()) {
+    if (s.arm_session && !asked.empty()) {
       // Checked now against the robot's letters (the arm's present ones fill the rest).
-      const kin::Kinematics& k = s.arm->kinematics();
+      const kin::Kinematics& k = s.arm_session->arm.kinematics();
       if (k.configuration_names().empty()) {
         return fail(RTC_E_ARGUMENT,
                     fmt::format("setconf(\"{}\"): robot {} has no named configurations", asked,
@@ -752,10 +748,12 @@ int setconf(const char* configuration) {
                     Say::print);
       }
       const std::string present(
-          k.configuration_names()[k.configuration_of(s.robot->session->how().q()).index]);
+          k.configuration_names()[k.configuration_of(s.arm_session->robot.session->how().q())
+                                      .index]);
       (void)configuration_letters(k, asked, present);
     }
-    s.configuration = asked;
+    // Kept by the open session's arm only: rccl_open starts with none.
+    if (s.arm_session) s.arm_session->configuration = asked;
     return RTC_OK;
   });
 }
@@ -767,15 +765,16 @@ int move(POS_PTR p) {
     if (p != park && box == nullptr) return rtc_error;
     const std::string name = p == park ? "park" : box->name;
     if (const int c = check_can_move(s, "move(" + name + ")"); c != RTC_OK) return c;
-    if (p == park) box = &park_position(s);
+    ArmSession& a = *s.arm_session;
+    if (p == park) box = &park_position(s, a);
     take_nextmove();
-    const rc::PositionPtr target = build_position(*box, s.displacement);
-    apply_settings(s);
-    const rc::Motion m = s.arm->move(target);
-    s.displacement = math::Transform::identity();
+    const rc::PositionPtr target = build_position(*box, a.displacement);
+    apply_settings(a, s.settings);
+    const rc::Motion m = a.arm.move(target);
+    a.displacement = math::Transform::identity();
     box->queued.push_back(target);
-    s.motion_names[m.id] = name;
-    s.motion_boxes[m.id] = box;
+    a.motion_names[m.id] = name;
+    a.motion_boxes[m.id] = box;
     refresh();
     return RTC_OK;
   });
@@ -790,9 +789,10 @@ int stop(double ms) {
       return fail(RTC_E_ARGUMENT, fmt::format("stop({}): the time is > 0 ms", ms), Say::print);
     }
     if (const int c = check_can_move(s, fmt::format("stop({})", ms)); c != RTC_OK) return c;
-    apply_settings(s);
-    const rc::Motion m = s.arm->dwell(ms * 1e-3);
-    s.motion_names[m.id] = fmt::format("stop {} ms", ms);
+    ArmSession& a = *s.arm_session;
+    apply_settings(a, s.settings);
+    const rc::Motion m = a.arm.dwell(ms * 1e-3);
+    a.motion_names[m.id] = fmt::format("stop {} ms", ms);
     refresh();
     return RTC_OK;
   });
@@ -857,7 +857,8 @@ int distance(const char* what, ...) {
                   Say::print);
     }
     trans.R = rotation;
-    s.displacement = s.displacement * trans;
+    // Kept by the open session's arm only: rccl_open starts with none.
+    if (s.arm_session) s.arm_session->displacement = s.arm_session->displacement * trans;
     return RTC_OK;
   });
 }
@@ -866,21 +867,22 @@ int rccl_wait_sample(void) {
   return guarded("waitfor", Say::print, RTC_E_INTERNAL, [] {
     State& s = state();
     take_nextmove();
-    if (s.cell) return cell_wait_tick();
-    if (!s.arm || !s.controlling) {
+    if (s.cell_session) return cell_wait_tick();
+    if (!s.arm_session || !s.arm_session->controlling) {
       return fail(RTC_E_SEQUENCE,
                   "waitfor: nothing runs to wait on; call rccl_open() and rccl_control() first",
                   Say::print);
     }
-    rtc::Session& session = *s.robot->session;
+    ArmSession& a = *s.arm_session;
+    rtc::Session& session = *a.robot.session;
     if (session.controlling()) session.wait_for(session.period());
-    report_failures();
+    report_failures(a);
     const rtc::How how = session.how();
     rtime = std::lround(how.time_s * 1e3);
     rccl_sample = static_cast<long>(how.sample);
-    to_c(s.arm->kinematics().forward(how.q()), t6_box().c);
+    to_c(a.arm.kinematics().forward(how.q()), t6_box().c);
     refresh();
-    if (!session.controlling()) return control_ended("waitfor");
+    if (!session.controlling()) return control_ended(a, "waitfor");
     return RTC_OK;
   });
 }
@@ -903,7 +905,7 @@ TRSF_PTR solve_update(const char* call, TRSF_PTR trans, POS_PTR pos,
                               call, box->name),
                   Say::print);
     }
-    if (!s.arm) {
+    if (!s.arm_session) {
       return fail(RTC_E_SEQUENCE,
                   fmt::format("{}: call rccl_open() first (T6 is read from the arm)", call),
                   Say::print);
@@ -916,7 +918,7 @@ TRSF_PTR solve_update(const char* call, TRSF_PTR trans, POS_PTR pos,
                               x->name, p->describe()),
                   Say::print);
     }
-    to_c(p->solve_for(*xt, t6 ? *t6 : measured_t6(s)), *trans);
+    to_c(p->solve_for(*xt, t6 ? *t6 : measured_t6(*s.arm_session)), *trans);
     out = trans;
     return RTC_OK;
   });
@@ -924,13 +926,14 @@ TRSF_PTR solve_update(const char* call, TRSF_PTR trans, POS_PTR pos,
 }
 
 /// The contact of the last motion to `box` that ended, if its guard tripped.
-std::optional<rc::Contact> last_contact(State& s, const PositionBox* box) {
-  if (!s.arm) return std::nullopt;
-  for (auto it = s.motion_boxes.rbegin(); it != s.motion_boxes.rend(); ++it) {
+std::optional<rc::Contact> last_contact(const State& s, const PositionBox* box) {
+  if (!s.arm_session) return std::nullopt;
+  const ArmSession& a = *s.arm_session;
+  for (auto it = a.motion_boxes.rbegin(); it != a.motion_boxes.rend(); ++it) {
     if (it->second != box) continue;
     const rc::Motion m{it->first};
-    if (!s.arm->happened(m.end())) continue;
-    return s.arm->contact(m);
+    if (!a.arm.happened(m.end())) continue;
+    return a.arm.contact(m);
   }
   return std::nullopt;
 }
@@ -976,7 +979,8 @@ int teach(TRSF_PTR trans, POS_PTR pos) {
                   Say::print);
     }
     rc::PositionDb& db = *opened;
-    const std::string& robot = s.arm->kinematics().model().name;
+    ArmSession& a = *s.arm_session;
+    const std::string& robot = a.arm.kinematics().model().name;
     if (const auto stored = db.get(robot, x->name)) {
       to_c(stored->value, *trans);
       std::printf("teach: %s taken from the position database %s\n", x->name.c_str(), file.c_str());
@@ -986,9 +990,9 @@ int teach(TRSF_PTR trans, POS_PTR pos) {
     std::printf("teach mode V1.0, transform %s, position %s\n", x->name.c_str(), box->name.c_str());
     std::fflush(stdout);
     rc::TeachIo io{std::cin, std::cout, &db, {}};
-    io.push = [&s](std::size_t joint, double effort) { s.robot->push(joint, effort); };
-    const rc::Taught taught = rc::teach_loop(*s.arm, io);
-    report_failures();
+    io.push = [&a](std::size_t joint, double effort) { a.robot.push(joint, effort); };
+    const rc::Taught taught = rc::teach_loop(a.arm, io);
+    report_failures(a);
     refresh();
     if (!taught.ended_by_exit || taught.termination.ended() || taught.stopped_by_signal) {
       std::printf("teach: nothing taught for %s\n", x->name.c_str());
@@ -1145,11 +1149,13 @@ int setload(double kg, double x, double y, double z) {
                               kg, x, y, z),
                   Say::print);
     }
-    if (!s.arm) return fail(RTC_E_SEQUENCE, "setload: call rccl_open() first", Say::print);
+    if (!s.arm_session) {
+      return fail(RTC_E_SEQUENCE, "setload: call rccl_open() first", Say::print);
+    }
     rccx::force::ToolLoad load;
     load.mass_kg = kg;
     load.com_m = {x * 1e-3, y * 1e-3, z * 1e-3};
-    s.arm->set_tool_load(load);
+    s.arm_session->arm.set_tool_load(load);
     return RTC_OK;
   });
 }
