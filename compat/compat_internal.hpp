@@ -1,10 +1,10 @@
 // What the files of rccx's C layer (rccl.h, rtc.h) share: the state a C program drives, the
 // boxes behind its TRSF and POS pointers, and error reporting. Not installed.
 //
-// The state is one `State` (state(), a function-local static: the layer owns it, it lives until
-// exit). Its program-wide part (transforms, positions, settings, the last error) lasts for the
-// whole program; the rest is one session at a time, each a std::optional that its open call
-// emplaces and its close call resets:
+// The state is one `State` (state() in rccl_session.cpp, a function-local static: the layer
+// owns it, it lives until exit). Its program-wide part (transforms, positions, settings, the last
+// error) lasts for the whole program; the rest is one session at a time, each a std::optional that
+// its open call emplaces and its close call resets:
 //
 //   State& s = state();
 //   s.arm_session.emplace(model, options);  // rccl_open: a simulated robot and its Manipulator
@@ -15,6 +15,10 @@
 // At most one of them is open (and neither while the RTC level's session is, rtc_compat.cpp).
 // The sample loop reads the open one (t6 for a C functional transform, nextmove) only while
 // control runs: the session is emplaced before control starts and reset after it stopped.
+//
+// The calls: rccl_session.cpp (open, control, close, errors), rccl_motion.cpp (settings, move,
+// stop, distance, waitfor), rccl_teach.cpp (makeposition, update, teach), rccl_transforms.cpp and
+// rccl_algebra.cpp (TRSF), rccl_cell.cpp (a cell's robots), rtc_compat.cpp (rtc.h, its own state).
 //
 // rccx's headers come first and the C headers last, so that the C macros (EQ, TL, Rot, waitfor,
 // ...) never reach rccx's headers; the C names (move, stop, park, t6, ...) are why these files
@@ -230,8 +234,19 @@ rc::PositionPtr build_position(const PositionBox& p, const math::Transform& extr
 
 /// Brings POS.end, POS.code, `completed` and t6's value up to date with the generators.
 void refresh() noexcept;
-/// Prints the motions of the one-robot session that failed since the last call.
-void report_failures();
+/// Prints the motions of the arm that failed since the last call (and sets POS.code).
+void report_failures(ArmSession& a);
+/// The arm's measured T6 (m, rad).
+math::Transform measured_t6(const ArmSession& a);
+/// The checks every motion call of one arm makes (an arm open and controlling, no cell): RTC_OK
+/// or the error, printed. `what` names the call in the message.
+int check_can_move(State& s, const std::string& what);
+/// Control has ended by itself: RTC_E_TERMINATED, printed the first time only.
+int control_ended(ArmSession& a, std::string_view call);
+/// The box behind `park` for the open session (built on first use; the arm's park joints).
+PositionBox& park_position(State& s, const ArmSession& a);
+/// The position box of `p` (park included), or null with the error printed.
+PositionBox* position_of(POS_PTR p, const char* call);
 /// Calls take(word) for each word of `text` (separated by spaces, commas or tabs; empty words
 /// too, which take() skips): the argument strings of distance(), comply(), limit() and
 /// mnp_touch().
