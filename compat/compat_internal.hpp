@@ -1,8 +1,28 @@
-// What the files of rccx's C layer (rccl.h, rtc.h) share: the state of the one session or
-// cell a C program drives, the boxes behind its TRSF and POS pointers, and error reporting.
-// Not installed. rccx's headers come first and the C headers last, so that the C macros (EQ,
-// TL, Rot, waitfor, ...) never reach rccx's headers; the C names (move, stop, park, t6, ...)
-// are why these files write std::move.
+// What the files of rccx's C layer (rccl.h, rtc.h) share: the state a C program drives, the
+// boxes behind its TRSF and POS pointers, and error reporting. Not installed.
+//
+// The state is one `State` (state() in rccl_session.cpp, a function-local static: the layer
+// owns it, it lives until exit). Its program-wide part (transforms, positions, settings, the last
+// error) lasts for the whole program; the rest is one session at a time, each a std::optional that
+// its open call emplaces and its close call resets:
+//
+//   State& s = state();
+//   s.arm_session.emplace(model, options);  // rccl_open: a simulated robot and its Manipulator
+//   s.arm_session->arm.move(target);        // move(), stop(), waitfor(), teach() ...
+//   s.arm_session.reset();                  // rccl_close: all of it goes, in one step
+//   s.cell_session.emplace(std::move(cell));  // rccl_cell_open; MANIP handles, mnp_*
+//
+// At most one of them is open (and neither while the RTC level's session is, rtc_compat.cpp).
+// The sample loop reads the open one (t6 for a C functional transform, nextmove) only while
+// control runs: the session is emplaced before control starts and reset after it stopped.
+//
+// The calls: rccl_session.cpp (open, control, close, errors), rccl_motion.cpp (settings, move,
+// stop, distance, waitfor), rccl_teach.cpp (makeposition, update, teach), rccl_transforms.cpp and
+// rccl_algebra.cpp (TRSF), rccl_cell.cpp (a cell's robots), rtc_compat.cpp (rtc.h, its own state).
+//
+// rccx's headers come first and the C headers last, so that the C macros (EQ, TL, Rot, waitfor,
+// ...) never reach rccx's headers; the C names (move, stop, park, t6, ...) are why these files
+// write std::move.
 #pragma once
 
 #include <fmt/format.h>
@@ -13,6 +33,7 @@
 #include <initializer_list>
 #include <map>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -87,36 +108,59 @@ struct PositionBox {
   std::vector<rc::PositionPtr> queued;
 };
 
-/// Everything the C calls share. Members are destroyed in reverse order: the manipulator
-/// before the robot whose session it uses, both before the positions and transforms.
-struct State {
-  std::map<const TRSF*, std::unique_ptr<TrsfBox>> transforms;
-  std::map<const POS*, std::unique_ptr<PositionBox>> positions;
-  rc::MotionSettings settings;  ///< setvel, setmod, settime: applied at each move()
-  std::string configuration;    ///< setconf, as letters ("" keeps the present one)
+/// The motions refused during a session: a 1986 program does not look at move()'s result, so
+/// rccl_close() and rcclRelease() tell.
+struct Refusals {
+  std::size_t count = 0;  ///< refused calls in this session
+  int first_code = RTC_OK;
+  std::string first;  ///< the first refusal's message
+  /// Counts `code` when it is an error; the first one's message (rtc_error_message) is kept.
+  void note(int code) noexcept;
+};
+
+/// What an open arm (rccl_open .. rccl_close) needs. Members are destroyed in reverse order:
+/// the manipulator before the robot whose session it uses.
+struct ArmSession {
+  ArmSession(kin::RobotModel model, const rtc::SimulatedRobotOptions& options);
+  rtc::SimulatedRobot robot;
+  rc::Manipulator arm;
+  std::string configuration;  ///< setconf, as letters ("" keeps the present one)
   math::Transform displacement = math::Transform::identity();  ///< distance(), for the next move
-  std::unique_ptr<rtc::SimulatedRobot> robot;
-  std::unique_ptr<rc::Manipulator> arm;
   bool controlling = false;  ///< rccl_control() was called in this session
   bool told_ended = false;   ///< the end of control was printed
-  /// The session main() opened for a manual-style pumatask(): the task's own rccl_open and
-  /// rccl_control are then accepted (rccl_open reopens it as asked while nothing has moved).
-  bool opened_for_task = false;
   /// The sample at which every queued motion had ended (0: not yet): `completed` waits from
   /// there for the measured arm to come to rest, at most kSettleTimeout_s.
   std::uint64_t ended_at_sample = 0;
   std::size_t failures_seen = 0;
-  std::size_t refused_moves = 0;  ///< move() calls that failed in this session
-  int first_refusal_code = RTC_OK;
-  std::string first_refusal;
+  Refusals refusals;                                   ///< move() calls that failed
   std::map<std::uint64_t, std::string> motion_names;   ///< motion id -> position name
   std::map<std::uint64_t, PositionBox*> motion_boxes;  ///< motion id -> its position
-  std::string message;                                 ///< the last error's
-  // A cell (rccl_cell_open): declared last, so that it stops before the positions and
-  // transforms its generators point to go.
+};
+
+/// What an open cell (rccl_cell_open .. rcclRelease) needs: the cell, its robots' MANIP handles.
+struct CellSession {
+  explicit CellSession(std::unique_ptr<rccx::cell::Cell> loaded) : cell(std::move(loaded)) {}
   std::map<std::string, std::unique_ptr<rccl_manip>, std::less<>> manips;
+  /// After the handles, which point into it: it stops its robots before they go.
   std::unique_ptr<rccx::cell::Cell> cell;
-  bool cell_started = false;
+  bool started = false;  ///< rcclStart() was called
+  Refusals refusals;     ///< mnp_move() calls that failed
+};
+
+/// Everything the C calls share: the program-wide part, then the one open session. Members are
+/// destroyed in reverse order: a session before the positions and transforms its generators
+/// point to.
+struct State {
+  std::map<const TRSF*, std::unique_ptr<TrsfBox>> transforms;
+  std::map<const POS*, std::unique_ptr<PositionBox>> positions;
+  rc::MotionSettings settings;  ///< setvel, setmod, settime: applied at each move()
+  std::string message;          ///< the last error's
+  /// main() opened the session for a manual-style pumatask(): the task's own rccl_open and
+  /// rccl_control are then accepted (rccl_open reopens it as asked while nothing has moved).
+  /// Program-wide: it stays set when the task closes that session itself.
+  bool opened_for_task = false;
+  std::optional<ArmSession> arm_session;    ///< rccl_open .. rccl_close
+  std::optional<CellSession> cell_session;  ///< rccl_cell_open .. rcclRelease
 };
 
 State& state();
@@ -190,8 +234,19 @@ rc::PositionPtr build_position(const PositionBox& p, const math::Transform& extr
 
 /// Brings POS.end, POS.code, `completed` and t6's value up to date with the generators.
 void refresh() noexcept;
-/// Prints the motions of the one-robot session that failed since the last call.
-void report_failures();
+/// Prints the motions of the arm that failed since the last call (and sets POS.code).
+void report_failures(ArmSession& a);
+/// The arm's measured T6 (m, rad).
+math::Transform measured_t6(const ArmSession& a);
+/// The checks every motion call of one arm makes (an arm open and controlling, no cell): RTC_OK
+/// or the error, printed. `what` names the call in the message.
+int check_can_move(State& s, const std::string& what);
+/// Control has ended by itself: RTC_E_TERMINATED, printed the first time only.
+int control_ended(ArmSession& a, std::string_view call);
+/// The box behind `park` for the open session (built on first use; the arm's park joints).
+PositionBox& park_position(State& s, const ArmSession& a);
+/// The position box of `p` (park included), or null with the error printed.
+PositionBox* position_of(POS_PTR p, const char* call);
 /// Calls take(word) for each word of `text` (separated by spaces, commas or tabs; empty words
 /// too, which take() skips): the argument strings of distance(), comply(), limit() and
 /// mnp_touch().

@@ -1,5 +1,5 @@
 // What the RTC level (rtc_compat.cpp: control, rtc_open, ...) and the RCCL level
-// (rccl_compat.cpp, rccl_cell.cpp: rccl_open, rccl_cell_open) of rccx's C layer must know of
+// (rccl_session.cpp, rccl_cell.cpp: rccl_open, rccl_cell_open) of rccx's C layer must know of
 // each other: one of them may have a session open at a time. Not installed.
 #pragma once
 

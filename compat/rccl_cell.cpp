@@ -55,8 +55,8 @@ bool cell_report(rccl_manip& m) {
 /// The handle `m` checked: a robot of the open cell.
 rccl_manip* known(const MANIP* m) {
   const State& s = state();
-  if (m == nullptr || !s.cell) return nullptr;
-  for (const auto& [name, box] : s.manips) {
+  if (m == nullptr || !s.cell_session) return nullptr;
+  for (const auto& [name, box] : s.cell_session->manips) {
     if (box.get() == m) return box.get();
   }
   return nullptr;
@@ -85,17 +85,17 @@ T* member_of(const MANIP* m, const char* call, T* rccl_manip::*member) {
 
 /// waitfor() with a cell: one tick of the cell's clock.
 int cell_wait_tick() {
-  State& s = state();
-  if (!s.cell_started) {
+  CellSession& c = *state().cell_session;
+  if (!c.started) {
     return fail(RTC_E_SEQUENCE, "waitfor: call rcclStart() before waiting on the cell", Say::print);
   }
   bool any = false;
-  for (auto& [name, m] : s.manips) any = any || m->arm->session().controlling();
-  if (any) s.cell->wait_for(s.cell->group().period());
+  for (auto& [name, m] : c.manips) any = any || m->arm->session().controlling();
+  if (any) c.cell->wait_for(c.cell->group().period());
   bool all_ended = true;
-  for (auto& [name, m] : s.manips) all_ended = cell_report(*m) && all_ended;
-  if (!s.manips.empty()) {
-    const rtc::How how = s.manips.begin()->second->arm->session().how();
+  for (auto& [name, m] : c.manips) all_ended = cell_report(*m) && all_ended;
+  if (!c.manips.empty()) {
+    const rtc::How how = c.manips.begin()->second->arm->session().how();
     rtime = std::lround(how.time_s * 1e3);
     rccl_sample = static_cast<long>(how.sample);
   }
@@ -116,7 +116,7 @@ extern "C" {
 int rccl_cell_open(const char* cell_file) {
   return guarded("rccl_cell_open", Say::quiet, RTC_E_ROBOT, [&] {
     State& s = state();
-    if (s.robot || s.cell) {
+    if (s.arm_session || s.cell_session) {
       return fail(RTC_E_SEQUENCE,
                   "rccl_cell_open: a session or cell is open; rccl_close() or rcclRelease() it "
                   "first",
@@ -138,14 +138,13 @@ int rccl_cell_open(const char* cell_file) {
       path =
           std::filesystem::exists(RCCX_DEFAULT_CELL, ec) ? RCCX_DEFAULT_CELL : RCCX_INSTALLED_CELL;
     }
+    std::unique_ptr<rccx::cell::Cell> loaded;
     try {
-      s.cell = rccx::cell::Cell::load(path);
+      loaded = rccx::cell::Cell::load(path);
     } catch (const rccx::cell::CellFileError& e) {
       return fail(RTC_E_ROBOT, fmt::format("rccl_cell_open: {}", e.what()), Say::quiet);
     }
-    s.cell_started = false;
-    s.refused_moves = 0;
-    s.first_refusal.clear();
+    s.cell_session.emplace(std::move(loaded));
     refresh();
     return RTC_OK;
   });
@@ -155,22 +154,23 @@ MANIP* rcclCreate(const char* name, int /*flags*/) {
   MANIP* out = nullptr;
   guarded("rcclCreate", Say::print, RTC_E_ROBOT, [&] {
     State& s = state();
-    if (!s.cell) {
+    if (!s.cell_session) {
       return fail(RTC_E_SEQUENCE, "rcclCreate: call rccl_cell_open() first", Say::print);
     }
+    CellSession& c = *s.cell_session;
     const std::string n = name != nullptr ? name : "";
-    if (const auto it = s.manips.find(n); it != s.manips.end()) {
+    if (const auto it = c.manips.find(n); it != c.manips.end()) {
       out = it->second.get();
       return RTC_OK;
     }
     auto m = std::make_unique<rccl_manip>();
     m->name = n;
-    m->arm = &s.cell->robot(n);  // std::invalid_argument names the cell's robots
-    const rccx::cell::CellRobot& cr = *s.cell->model().find_robot(n);
+    m->arm = &c.cell->robot(n);  // std::invalid_argument names the cell's robots
+    const rccx::cell::CellRobot& cr = *c.cell->model().find_robot(n);
     m->tool =
         keep_transform(rc::constant(n + "_TOOL", cr.tool.value_or(math::Transform::identity())));
     m->base_inv = keep_transform(rc::constant(n + "_BASE_INV", cr.base.inverse()));
-    m->tool_frame = keep_transform(s.cell->tool_frame(n));
+    m->tool_frame = keep_transform(c.cell->tool_frame(n));
     auto park_pos = std::make_unique<PositionBox>();
     park_pos->name = n + " park";
     park_pos->joints = m->arm->park();
@@ -178,7 +178,7 @@ MANIP* rcclCreate(const char* name, int /*flags*/) {
     m->park = &park_pos->c;
     s.positions.emplace(m->park, std::move(park_pos));
     out = m.get();
-    s.manips.emplace(n, std::move(m));
+    c.manips.emplace(n, std::move(m));
     return RTC_OK;
   });
   return out;
@@ -187,12 +187,13 @@ MANIP* rcclCreate(const char* name, int /*flags*/) {
 int rcclStart(void) {
   return guarded("rcclStart", Say::quiet, RTC_E_INTERNAL, [] {
     State& s = state();
-    if (!s.cell) return fail(RTC_E_SEQUENCE, "rcclStart: call rccl_cell_open() first", Say::quiet);
-    if (s.cell_started) {
-      return fail(RTC_E_SEQUENCE, "rcclStart: the cell runs already", Say::quiet);
+    if (!s.cell_session) {
+      return fail(RTC_E_SEQUENCE, "rcclStart: call rccl_cell_open() first", Say::quiet);
     }
-    s.cell->start();
-    s.cell_started = true;
+    CellSession& c = *s.cell_session;
+    if (c.started) return fail(RTC_E_SEQUENCE, "rcclStart: the cell runs already", Say::quiet);
+    c.cell->start();
+    c.started = true;
     refresh();
     return RTC_OK;
   });
@@ -201,23 +202,23 @@ int rcclStart(void) {
 int rcclRelease(int power_off) {
   return guarded("rcclRelease", Say::quiet, RTC_E_INTERNAL, [&] {
     State& s = state();
-    if (!s.cell) return fail(RTC_E_SEQUENCE, "rcclRelease: no cell is open", Say::quiet);
+    if (!s.cell_session) return fail(RTC_E_SEQUENCE, "rcclRelease: no cell is open", Say::quiet);
+    // Whatever happens below, the cell is gone afterwards.
     struct Closer {
       State& s;
       ~Closer() {
-        s.cell.reset();
-        s.cell_started = false;
-        s.manips.clear();
+        s.cell_session.reset();
         for (auto& [key, box] : s.positions) box->queued.clear();
         refresh();
       }
     } closer{s};
+    CellSession& c = *s.cell_session;
     int code = RTC_OK;
     std::string why;
-    for (auto& [name, m] : s.manips) {
-      if (s.cell_started) cell_report(*m);
+    for (auto& [name, m] : c.manips) {
+      if (c.started) cell_report(*m);
       const rtc::Termination t =
-          s.cell_started ? m->arm->stop_control() : m->arm->session().termination();
+          c.started ? m->arm->stop_control() : m->arm->session().termination();
       if (code != RTC_OK) continue;
       const std::vector<rc::MotionEvent>& failures = m->arm->failures();
       if (t.ended()) {
@@ -230,10 +231,10 @@ int rcclRelease(int power_off) {
                           rc::to_string(failures.front().kind), failures.front().message());
       }
     }
-    if (code == RTC_OK && s.refused_moves > 0) {
-      code = s.first_refusal_code;
-      why = fmt::format("{} mnp_move() call(s) were refused; the first: {}", s.refused_moves,
-                        s.first_refusal);
+    if (code == RTC_OK && c.refusals.count > 0) {
+      code = c.refusals.first_code;
+      why = fmt::format("{} mnp_move() call(s) were refused; the first: {}", c.refusals.count,
+                        c.refusals.first);
     }
     (void)power_off;  // the cell's robots hold; simulated arms have no power to cut
     return code == RTC_OK ? RTC_OK : fail(code, "rcclRelease: " + why, Say::quiet);
@@ -292,7 +293,7 @@ int mnp_move(MANIP* m, POS_PTR p) {
                               r->name, static_cast<const void*>(p)),
                   Say::print);
     }
-    if (!s.cell_started) {
+    if (!s.cell_session->started) {
       return fail(
           RTC_E_SEQUENCE,
           fmt::format("mnp_move({}, {}): call rcclStart() first", r->name, it->second->name),
@@ -318,14 +319,7 @@ int mnp_move(MANIP* m, POS_PTR p) {
     refresh();
     return RTC_OK;
   });
-  State& s = state();
-  if (code != RTC_OK && ++s.refused_moves == 1) {
-    s.first_refusal_code = code;
-    try {
-      s.first_refusal = rtc_error_message();
-    } catch (...) {
-    }
-  }
+  if (State& s = state(); s.cell_session) s.cell_session->refusals.note(code);
   return code;
 }
 
@@ -350,7 +344,7 @@ int mnp_touch(MANIP* m, const char* objects) {
       }
     }
     try {
-      r->next.touch = state().cell->objects(names);
+      r->next.touch = state().cell_session->cell->objects(names);
     } catch (const std::invalid_argument& e) {
       return fail(RTC_E_ARGUMENT,
                   fmt::format("mnp_touch({}, \"{}\"): {}", r->name,
@@ -390,7 +384,7 @@ int mnp_after(MANIP* m, MANIP* other, int motion, int event) {
     }
     const rc::Motion mo{static_cast<std::uint64_t>(motion)};
     r->next.after.push_back(
-        state().cell->event(o->name, event == RCCL_START ? mo.start() : mo.end()));
+        state().cell_session->cell->event(o->name, event == RCCL_START ? mo.start() : mo.end()));
     return RTC_OK;
   });
 }
@@ -418,8 +412,8 @@ int rccl_together(int end_together, ...) {
       if (r == nullptr) return bad_handle("rccl_together");
       names.push_back(r->name);
     }
-    if (!s.cell) return fail(RTC_E_SEQUENCE, "rccl_together: no cell is open", Say::print);
-    const rccx::cell::Together t = s.cell->together(names, end_together != 0);
+    if (!s.cell_session) return fail(RTC_E_SEQUENCE, "rccl_together: no cell is open", Say::print);
+    const rccx::cell::Together t = s.cell_session->cell->together(names, end_together != 0);
     for (std::size_t i = 0; i < n; ++i) {
       rccl_manip* r = known(list[i]);
       r->next.together = t.rendezvous;

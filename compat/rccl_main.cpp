@@ -7,7 +7,7 @@
 extern "C" int pumatask();
 
 namespace rccx::compat {
-// rccl_compat.cpp: the session main() opened is the task's; is a session still open?
+// rccl_session.cpp: the session main() opened is the task's; is a session still open?
 void mark_session_for_task() noexcept;
 bool session_open() noexcept;
 }  // namespace rccx::compat

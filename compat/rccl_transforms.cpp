@@ -34,7 +34,7 @@ void measured_t6_in_loop(const rc::SampleContext& ctx) noexcept {
   const long sample = static_cast<long>(ctx.sample);
   if (t6b.c.age == sample) return;
   const State& s = state();
-  const kin::Kinematics* k = s.arm ? &s.arm->kinematics() : nullptr;
+  const kin::Kinematics* k = s.arm_session ? &s.arm_session->arm.kinematics() : nullptr;
   if (k == nullptr || ctx.how->dof != k->dof()) return;  // a cell: several arms, no one T6
   to_c(k->forward(ctx.how->q()), t6b.c);
   t6b.c.age = sample;
