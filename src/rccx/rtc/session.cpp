@@ -19,7 +19,9 @@
 #include "rccx/kinematics/kinematics.hpp"
 #include "rccx/rtc/doorbell.hpp"
 #include "rccx/rtc/hangup.hpp"
+#include "rccx/rtc/joint_commands.hpp"
 #include "rccx/rtc/latest.hpp"
+#include "rccx/rtc/sample_checks.hpp"
 
 namespace rccx::rtc {
 
@@ -42,10 +44,6 @@ constexpr bool kLockMemory = false;  // the sanitizers' shadow memory is terabyt
 #else
 constexpr bool kLockMemory = true;
 #endif
-
-const char* unit_of(const kin::Joint& j) noexcept {
-  return j.type == kin::JointType::revolute ? "rad" : "m";
-}
 
 void try_real_time_scheduling(std::thread& t, int priority) {
   static std::once_flag locked;
@@ -160,8 +158,7 @@ struct Session::CommState {
   std::uint32_t hangups_seen = 0;
   bool power_expected = false;
   bool ended = false;
-  std::array<double, kMaxJoints> last_target{};
-  std::array<bool, kMaxJoints> has_target{};
+  JointTargets targets;
 };
 
 // One robot's side: what the planning level, the communication task and the control task
@@ -883,7 +880,6 @@ bool Session::communication_cycle(CommState& c, std::uint32_t k, std::int64_t ti
 bool Session::controlled_cycle(CommState& c, std::uint32_t k) noexcept {
   Shared& s = *shared_;
   How& h = c.how;
-  const auto& joints = driver_.model().joints;
   const std::int64_t period = this->period().count();
 
   const std::uint32_t generation = s.generation.load(std::memory_order_relaxed);
@@ -893,93 +889,22 @@ bool Session::controlled_cycle(CommState& c, std::uint32_t k) noexcept {
     c.power_expected = h.power;
     c.ended = false;
     c.chg = Chg{};
-    c.has_target = {};
+    c.targets.has = {};
   }
   if (c.ended) return false;
 
-  if (const std::int32_t code = s.requested_code.exchange(0); code != 0) {
-    end_control(c, static_cast<TerminateCode>(code), s.requested_joint.load(), "");
+  EndRequests requests;
+  requests.code = static_cast<TerminateCode>(s.requested_code.exchange(0));
+  requests.joint = s.requested_joint.load();
+  requests.hangups = detail::hangup_count();
+  requests.user_hangup = s.user_hangup.load(std::memory_order_relaxed);
+  std::optional<Stop> stop = check_requests(requests, c.hangups_seen);
+  if (!stop) stop = check_faults(h, c.power_expected, driver_);
+  if (!stop) stop = check_force(h.force, c.chg.checking);
+  if (!stop) stop = check_observed_limits(h, driver_, period, c.chg.checking);
+  if (stop) {
+    end_control(c, stop->code, stop->joint, stop->detail_view());
     return false;
-  }
-  if (const std::uint32_t n = detail::hangup_count(); n != c.hangups_seen) {
-    c.hangups_seen = n;
-    if (!s.user_hangup.load(std::memory_order_relaxed)) {
-      end_control(c, TerminateCode::user_interrupt, 0, "");
-      return false;
-    }
-  }
-
-  // Power first: losing it makes every joint report a fault.
-  if (c.power_expected && !h.power) {
-    end_control(c, TerminateCode::power_failure, 0, "arm power went off");
-    return false;
-  }
-  static constexpr std::pair<JointFlag, TerminateCode> kFaults[] = {
-      {kNotAnswering, TerminateCode::joint_not_answering},
-      {kEncoderError, TerminateCode::encoder_error},
-      {kPhaseError, TerminateCode::phase_error},
-      {kJointFault, TerminateCode::joint_fault},
-  };
-  for (std::size_t i = 0; i < h.dof; ++i) {
-    for (const auto& [flag, code] : kFaults) {
-      if (h.joint[i].has(flag)) {
-        end_control(c, code, static_cast<int>(i) + 1, driver_.fault_detail(i));
-        return false;
-      }
-    }
-  }
-
-  // The wrist sensor: a reading at its range or one that no longer changes means nothing.
-  if (h.force.present && (c.chg.checking & kCheckForce) != 0) {
-    if (h.force.frozen) {
-      std::array<char, kMessageCapacity> d;
-      io::format_fixed(d, "the wrist sensor's reading {} repeated for {} samples", h.force.sequence,
-                       kForceFrozenSamples);
-      end_control(c, TerminateCode::force_frozen, 0, d.data());
-      return false;
-    }
-    if (h.force.saturated) {
-      const math::Wrench& w = h.force.wrench;
-      std::array<char, kMessageCapacity> d;
-      io::format_fixed(
-          d, "wrist force ({:.1f}, {:.1f}, {:.1f}) N, torque ({:.2f}, {:.2f}, {:.2f}) N m",
-          w.force_N.x, w.force_N.y, w.force_N.z, w.torque_N_m.x, w.torque_N_m.y, w.torque_N_m.z);
-      end_control(c, TerminateCode::force_saturated, 0, d.data());
-      return false;
-    }
-  }
-
-  // Observed limits.
-  for (std::size_t i = 0; i < h.dof; ++i) {
-    JointHow& j = h.joint[i];
-    // Only calibrated joints: an uncalibrated position means nothing yet, and a calibrating
-    // joint may stand on its mechanical stop, outside its range.
-    if (!j.has(kCalibrated) || j.has(kCalibrating)) continue;
-    const kin::Joint& m = joints[i];
-    const double position_slack = 2.0 * m.resolution_per_count;  // quantisation at a hard stop
-    if (!(j.q >= m.lower - position_slack && j.q <= m.upper + position_slack)) {
-      j.flags |= kObservedPositionOut;
-      if ((c.chg.checking & kCheckObservedPosition) != 0) {
-        std::array<char, kMessageCapacity> d;
-        io::format_fixed(d, "joint {} measured at {:.5f} {}, limits [{:.5f}, {:.5f}]", i + 1, j.q,
-                         unit_of(m), m.lower, m.upper);
-        end_control(c, TerminateCode::observed_position, static_cast<int>(i) + 1, d.data());
-        return false;
-      }
-    }
-    // Speeds come from encoder differences: allow their quantisation and a little overshoot.
-    const double top = driver_.velocity_limit(i, static_cast<double>(period) * 1e-9);
-    const double speed_slack = 0.05 * top + 2.0 * m.resolution_per_count / 0.010;
-    if (std::abs(j.velocity) > top + speed_slack) {
-      j.flags |= kObservedVelocityOut;
-      if ((c.chg.checking & kCheckObservedVelocity) != 0) {
-        std::array<char, kMessageCapacity> d;
-        io::format_fixed(d, "joint {} measured at {:.4f} {}/s, maximum {:.4f}", i + 1, j.velocity,
-                         unit_of(m), top);
-        end_control(c, TerminateCode::observed_velocity, static_cast<int>(i) + 1, d.data());
-        return false;
-      }
-    }
   }
 
   // This robot's How for the control task; the clock hands every robot's over at once. (One
@@ -1003,30 +928,20 @@ void Session::apply_taken(CommState& c) noexcept {
     row.t_s = h.time_s;
     row.segment = c.chg.segment;
     row.measured = h.q();
-    row.commanded = row.measured;
-    for (std::size_t i = 0; i < h.dof; ++i) {
-      if (c.has_target[i]) row.commanded[i] = c.last_target[i];
-    }
+    row.commanded = c.targets.commanded(row.measured);
     log->push(row);
   }
   if (s.tap.load(std::memory_order_relaxed) != nullptr) {
     // set_tap(nullptr) waits while tap_busy: busy is raised before the pointer is read again
     // (sequentially consistent, as the detaching side's store and load are).
     s.tap_busy.store(true);
-    if (SampleTap* tap = s.tap.load()) {
-      JointVector commanded = h.q();
-      for (std::size_t i = 0; i < h.dof; ++i) {
-        if (c.has_target[i]) commanded[i] = c.last_target[i];
-      }
-      tap->on_sample(h, commanded, c.chg.segment);
-    }
+    if (SampleTap* tap = s.tap.load()) tap->on_sample(h, c.targets.commanded(h.q()), c.chg.segment);
     s.tap_busy.store(false, std::memory_order_release);
   }
 }
 
 void Session::apply(CommState& c, const Chg& chg) noexcept {
   How& h = c.how;
-  const auto& joints = driver_.model().joints;
   const double period_s = std::chrono::duration<double>(period()).count();
 
   if (chg.power == Request::on) {
@@ -1047,56 +962,9 @@ void Session::apply(CommState& c, const Chg& chg) noexcept {
   }
 
   JointCommands commands{};
-  for (std::size_t i = 0; i < h.dof; ++i) {
-    const JointChg& m = chg.motion[i];
-    const kin::Joint& joint = joints[i];
-    JointHow& j = h.joint[i];
-    const int number = static_cast<int>(i) + 1;
-    if (m.set == SetMode::none) continue;
-    if (m.set == SetMode::stopcal) {
-      commands[i].kind = JointCommand::Kind::calibrate;
-      c.has_target[i] = false;
-      continue;
-    }
-    if (!j.has(kCalibrated)) {
-      j.flags |= kNotCalibratedTarget;
-      return end_control(c, TerminateCode::not_calibrated, number, "");
-    }
-    double target = joint.lower + m.range_target;
-    if (!(target >= joint.lower - kin::kLimitTolerance &&
-          target <= joint.upper + kin::kLimitTolerance)) {
-      j.flags |= kTargetPositionOut;
-      if ((chg.checking & kCheckTargetPosition) != 0 || !std::isfinite(target)) {
-        std::array<char, kMessageCapacity> d;
-        io::format_fixed(d, "joint {} commanded to {:.5f} {}, limits [{:.5f}, {:.5f}]", number,
-                         target, unit_of(joint), joint.lower, joint.upper);
-        return end_control(c, TerminateCode::target_position, number, d.data());
-      }
-      target = std::clamp(target, joint.lower, joint.upper);  // never sent outside the limits
-    }
-    const double from = c.has_target[i] ? c.last_target[i] : j.q;
-    const double top = driver_.velocity_limit(i, period_s);  // at most the model's top speed
-    // POSVEL to the last target again, give or take a rounding (a joint that a Cartesian motion
-    // no longer moves): rate 0, at once. A rate of 1e-13 m/s would leave a driver that paces its
-    // desired point by the rate (the Microbo's) behind the target for good.
-    double rate =
-        m.set == SetMode::posvel
-            ? (std::abs(target - from) <= kin::kLimitTolerance ? 0.0
-                                                               : std::abs(target - from) / period_s)
-            : (m.velocity > 0.0 ? m.velocity : kDefaultSpeedFraction * top);
-    if (!(rate <= top * (1.0 + 1e-9))) {
-      j.flags |= kTargetVelocityOut;
-      if ((chg.checking & kCheckTargetVelocity) != 0 || !std::isfinite(rate)) {
-        std::array<char, kMessageCapacity> d;
-        io::format_fixed(d, "joint {} commanded at {:.4f} {}/s, maximum {:.4f}", number, rate,
-                         unit_of(joint), top);
-        return end_control(c, TerminateCode::target_velocity, number, d.data());
-      }
-      rate = top;  // arrives late rather than too fast
-    }
-    commands[i] = {JointCommand::Kind::move, target, rate};
-    c.last_target[i] = target;
-    c.has_target[i] = true;
+  if (const std::optional<Stop> stop =
+          to_joint_commands(chg, driver_, period_s, h, c.targets, commands)) {
+    return end_control(c, stop->code, stop->joint, stop->detail_view());
   }
   driver_.send(commands);
 }
