@@ -1,10 +1,12 @@
 // A driver for the RTC sample steps' tests without threads or an arm (rtc_checks_test.cpp,
-// rtc_joint_commands_test.cpp): a two-joint robot, one revolute and one prismatic, whose top
-// speeds and fault details the test sets, and which remembers the period it was asked about.
+// rtc_joint_commands_test.cpp, rtc_channel_test.cpp): a two-joint robot, one revolute and one
+// prismatic, whose readings, top speeds and fault details the test sets, and which remembers
+// what it was asked (the period of a top speed, commands sent, holds, power).
 //
 //   FakeDriver driver;
 //   driver.top = {1.0, 0.05};                  // rad/s, m/s
-//   rtc::How how = driver.calibrated_how({0.0, 0.25});
+//   driver.arm = driver.calibrated_how({0.0, 0.25});   // what read() returns
+//   ... driver.sends, driver.sent[0].target, driver.holds
 #pragma once
 
 #include <array>
@@ -40,18 +42,25 @@ inline kin::RobotModel two_joint_model() {
 }
 
 class FakeDriver final : public rtc::Driver {
+  kin::RobotModel model_ = two_joint_model();  // first: the members below read it
+
  public:
-  FakeDriver() : model_(two_joint_model()) {}
   const kin::RobotModel& model() const noexcept override { return model_; }
-  void read(double, rtc::How&) noexcept override {}
-  void send(const rtc::JointCommands&) noexcept override {}
-  void hold() noexcept override {}
+  void read(double, rtc::How& how) noexcept override { how = arm; }
+  void send(const rtc::JointCommands& commands) noexcept override {
+    sent = commands;
+    ++sends;
+  }
+  void hold() noexcept override { ++holds; }
   double velocity_limit(std::size_t joint, double period_s) const noexcept override {
     asked_period_s = period_s;
     return top[joint];
   }
   std::string_view fault_detail(std::size_t joint) const noexcept override { return faults[joint]; }
-  bool set_power(bool) noexcept override { return true; }
+  bool set_power(bool on) noexcept override {
+    arm.power = on;
+    return true;
+  }
   void set_hand_closed(bool) noexcept override {}
   void set_zero_gravity(bool) noexcept override {}
   void set_outputs(std::uint16_t) noexcept override {}
@@ -72,10 +81,10 @@ class FakeDriver final : public rtc::Driver {
 
   std::array<double, 2> top{2.0, 0.1};  ///< velocity_limit's answers, rad/s and m/s
   std::array<std::string_view, 2> faults{};
-  mutable double asked_period_s = -1.0;  ///< the period velocity_limit was last asked for, s
-
- private:
-  kin::RobotModel model_;
+  mutable double asked_period_s = -1.0;        ///< the period velocity_limit was last asked for, s
+  rtc::How arm = calibrated_how({0.0, 0.25});  ///< what read() returns
+  rtc::JointCommands sent{};                   ///< the last commands sent
+  int sends = 0, holds = 0;
 };
 
 }  // namespace rtc_test
