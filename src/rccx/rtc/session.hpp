@@ -1,13 +1,27 @@
 // An RTC session (thesis 2.3 and 4.5): open it on a robot's driver, start control with two
 // user functions run once per sample, release, control again, close. Two threads serve it,
-// as the thesis's two processors did (figure 4.7):
+// as the thesis's two processors did (figure 4.7). The pipeline, one sample in order:
 //
-//   communication task: at each tick reads the arm into How, checks limits and faults, hands
-//                       How over; takes Chg after f1 and turns it into joint commands while
-//                       the control task runs f2; checks that the last control cycle finished.
-//   control task:       copies How, runs f1, hands Chg over, runs f2, kicks the watchdog.
+//   communication task                          control task
+//   1 wait for the tick
+//   2 watchdog: did the last control cycle
+//     finish within its period?
+//   3 each robot due: release()'s requests;
+//     read the arm into How; in control,
+//     the checks (requests, faults, force
+//     sensor, observed limits)
+//   4 hand every How over                  ->   5 each robot: copy How, run f1
+//   7 each robot: take Chg, turn it into   <-   6 hand every Chg over
+//     joint commands and send them; log,
+//     tap; publish How
+//   8 "Chg taken"; the tick is done        ->   9 each robot: f2 (then the robot hook)
+//                                               10 the cycle hook; kick the watchdog (2)
 //
-// They exchange How and Chg through sequence counters (acquire/release atomics and futex
+// (sample_clock.hpp: 1, 2, 4, 6, 8, 10 and the loops over the robots; robot_channel.hpp: each
+// robot's 3, 5, 7, 9, with sample_checks.hpp and joint_commands.hpp. With
+// SessionOptions::one_thread, the communication task does 3, 5, 7, 9 robot after robot.)
+//
+// The tasks exchange How and Chg through sequence counters (acquire/release atomics and futex
 // waits): no mutex, no allocation in the sample loop. A termination (limit, fault, overrun,
 // Ctrl-C, or a request) leaves the arm holding where it is, or powered down for power and
 // communication faults, and is reported to the planning level by the wait functions.
@@ -83,6 +97,8 @@ class SessionError : public std::runtime_error {
 };
 
 class Session;
+class RobotChannel;
+class SampleClock;
 
 /// What a control function sees: the How of its sample, the Chg it may write, and the
 /// session's `terminate` and `rtc_message`.
@@ -101,12 +117,12 @@ class Control {
   void spend(std::chrono::nanoseconds d) noexcept;
 
  private:
-  friend class Session;
+  friend class RobotChannel;
   How how_;
   Chg chg_;
   double period_s_ = 0.0;
   std::int64_t spent_ns_ = 0;
-  Session* session_ = nullptr;
+  RobotChannel* channel_ = nullptr;
   std::array<char, kMessageCapacity> message_{};
 };
 
@@ -188,48 +204,21 @@ class Session {
   void hangup();
 
  private:
-  friend class Control;
   friend class SessionGroup;
-  struct Shared;
-  struct CommState;
-  struct Clock;
 
   /// A robot of a group: sampled every `multiple`-th tick of `clock`.
-  Session(Driver& driver, std::shared_ptr<Clock> clock, int multiple, std::string log_suffix);
-  void open_channel(const std::string& log_suffix);
-
-  /// The communication task's work for this robot at tick k; true when it handed How to the
-  /// control task for this tick.
-  bool communication_cycle(CommState& c, std::uint32_t k, std::int64_t tick_ns) noexcept;
-  bool controlled_cycle(CommState& c, std::uint32_t k) noexcept;
-  void take_chg(CommState& c) noexcept;
-  /// c.chg into joint commands (and the log).
-  void apply_taken(CommState& c) noexcept;
-  void apply(CommState& c, const Chg& chg) noexcept;
-  void end_control(CommState& c, TerminateCode code, int joint, std::string_view detail) noexcept;
-  void run_guarded(ControlFunction& f) noexcept;
-  void run_f1(std::uint32_t k) noexcept;
-  std::int64_t run_f2() noexcept;
-  /// One thread: this robot's whole control cycle at tick k in one go (f1 on the communication
-  /// task's How, its Chg applied, f2); the computing f2 charged with spend().
-  std::int64_t run_cycle_in_place(std::uint32_t k) noexcept;
-  void request_termination(TerminateCode code, int joint) noexcept;
-  void wait_control_idle() const;
-  [[nodiscard]] Termination ended_termination() const;
+  Session(Driver& driver, std::shared_ptr<SampleClock> clock, int multiple,
+          const std::string& log_suffix);
+  void open_channel(int multiple, const std::string& log_suffix);
   void check_period(std::chrono::nanoseconds p) const;
-  [[nodiscard]] bool due(std::uint32_t k) const noexcept;
 
   Driver& driver_;
-  std::shared_ptr<Clock> clock_;
-  int multiple_ = 1;
+  std::shared_ptr<SampleClock> clock_;
   bool owns_clock_ = false;
-  std::unique_ptr<Shared> shared_;  ///< with the communication task's CommState: one allocation
-  CommState* comm_ = nullptr;       ///< the communication task's own, inside *shared_
-  std::size_t index_ = 0;           ///< in the group (0 alone)
-  std::function<void(Session&)> hangup_handler_;
   std::unique_ptr<SampleLog> environment_log_;  ///< RCCX_LOG's, when set
+  std::unique_ptr<RobotChannel> channel_;       ///< this robot's side of the sample loop
+  std::function<void(Session&)> hangup_handler_;
   std::string log_problem_;
-  ControlFunction f1_, f2_;
   bool closed_ = false;
 };
 
@@ -286,7 +275,7 @@ class SessionGroup {
   void set_robot_hook(std::function<void(std::size_t robot, std::uint32_t tick)> hook);
 
  private:
-  std::shared_ptr<Session::Clock> clock_;
+  std::shared_ptr<SampleClock> clock_;
   std::vector<std::unique_ptr<Session>> sessions_;
 };
 
