@@ -58,52 +58,72 @@ Manipulator::~Manipulator() {
 void Manipulator::start() {
   first_sample_ = true;
   limp_ = zero_gravity_ = false;
-  session_.control({}, [this](rtc::Control& c) {
-    const rtc::How& h = c.how();
-    const kin::JointVector measured = h.q();
-    // The setpoint written now goes out with the next sample and is reached one period later.
-    const double t_set = h.time_s + 2.0 * c.period_s();
-    if (first_sample_) {
-      generator_->reset(measured, t_set);
-      force_.reset();
-      first_sample_ = false;
-    }
-    if (const rtc::Request hand = hand_request_.exchange(rtc::Request::none);
-        hand != rtc::Request::none) {
-      c.chg().hand = hand;
-    }
-    if (const rtc::SettingChg set = setting_request_.exchange(rtc::SettingChg{});
-        set.what != rtc::Setting::none) {
-      c.chg().setting = set;
-    }
-    if (const rtc::Request zg = zero_gravity_request_.exchange(rtc::Request::none);
-        zg != rtc::Request::none) {
-      c.chg().zero_gravity = zg;
-      limp_ = zg == rtc::Request::on;
-      if (!limp_) generator_->reset(measured, t_set);  // at rest where the hand left it
-    }
-    if (limp_) {
-      c.chg().zero_gravity = rtc::Request::on;  // held every sample, as marsh does
-      return;
-    }
-    const SampleContext ctx{t_set, h.sample, &h};
-    kin::JointVector q;
-    const std::uint64_t id = generator_->step(ctx, &measured, q);
-    switch (force_.step(h, id, generator_->running_settings(id), c.period_s(), q)) {
-      case ForceControl::Outcome::none:
-        break;
-      case ForceControl::Outcome::contact:
-        generator_->request_next();
-        break;
-      case ForceControl::Outcome::overload:
-      case ForceControl::Outcome::unreachable:
-        generator_->request_stop(std::string_view(force_.why().data()));
-        break;
-    }
-    for (std::size_t j = 0; j < q.size(); ++j) c.chg().posvel(j, q[j] - lower_[j]);
-    c.chg().segment = static_cast<std::int32_t>(id);
-  });
+  session_.control({}, [this](rtc::Control& c) { run_sample(c); });
   started_ = true;
+}
+
+void Manipulator::run_sample(rtc::Control& c) {
+  const rtc::How& h = c.how();
+  const kin::JointVector measured = h.q();
+  // The setpoint written now goes out with the next sample and is reached one period later.
+  const double t_set = h.time_s + 2.0 * c.period_s();
+  if (first_sample_) {
+    generator_->reset(measured, t_set);
+    force_.reset();
+    first_sample_ = false;
+  }
+  if (forward_requests(c, measured, t_set)) return;
+  kin::JointVector q;
+  const std::uint64_t id = step_generator(h, measured, t_set, q);
+  apply_force(h, id, c.period_s(), q);
+  write_setpoints(c, q, id);
+}
+
+bool Manipulator::forward_requests(rtc::Control& c, const kin::JointVector& measured,
+                                   double t_set) noexcept {
+  if (const rtc::Request hand = hand_request_.exchange(rtc::Request::none);
+      hand != rtc::Request::none) {
+    c.chg().hand = hand;
+  }
+  if (const rtc::SettingChg set = setting_request_.exchange(rtc::SettingChg{});
+      set.what != rtc::Setting::none) {
+    c.chg().setting = set;
+  }
+  if (const rtc::Request zg = zero_gravity_request_.exchange(rtc::Request::none);
+      zg != rtc::Request::none) {
+    c.chg().zero_gravity = zg;
+    limp_ = zg == rtc::Request::on;
+    if (!limp_) generator_->reset(measured, t_set);  // at rest where the hand left it
+  }
+  if (limp_) c.chg().zero_gravity = rtc::Request::on;  // held every sample, as marsh does
+  return limp_;
+}
+
+std::uint64_t Manipulator::step_generator(const rtc::How& h, const kin::JointVector& measured,
+                                          double t_set, kin::JointVector& q) {
+  const SampleContext ctx{t_set, h.sample, &h};
+  return generator_->step(ctx, &measured, q);
+}
+
+void Manipulator::apply_force(const rtc::How& h, std::uint64_t id, double period_s,
+                              kin::JointVector& q) noexcept {
+  switch (force_.step(h, id, generator_->running_settings(id), period_s, q)) {
+    case ForceControl::Outcome::none:
+      break;
+    case ForceControl::Outcome::contact:
+      generator_->request_next();
+      break;
+    case ForceControl::Outcome::overload:
+    case ForceControl::Outcome::unreachable:
+      generator_->request_stop(std::string_view(force_.why().data()));
+      break;
+  }
+}
+
+void Manipulator::write_setpoints(rtc::Control& c, const kin::JointVector& q,
+                                  std::uint64_t id) noexcept {
+  for (std::size_t j = 0; j < q.size(); ++j) c.chg().posvel(j, q[j] - lower_[j]);
+  c.chg().segment = static_cast<std::int32_t>(id);
 }
 
 rtc::Termination Manipulator::stop_control() {

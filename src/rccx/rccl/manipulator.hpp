@@ -183,6 +183,27 @@ class Manipulator {
   [[nodiscard]] TrajectoryGenerator& generator() noexcept { return *generator_; }
 
  private:
+  // --- Loop side: f2, one sample, in the order it runs; nothing allocates, locks or throws
+  // except what a functional transform's function throws in the generator's step. ----------
+  /// The control function: the setpoint of this sample (rad / m) from the generator, the force
+  /// side's correction, written into the Chg with the planning level's requests.
+  void run_sample(rtc::Control& c);
+  /// Hands the planning level's one-shot requests (hand, joint setting, zero gravity) to this
+  /// sample's Chg; `measured` (rad / m) and `t_set` (s) restart the generator when zero gravity
+  /// ends. True when the arm is limp (zero gravity): nothing is commanded this sample.
+  bool forward_requests(rtc::Control& c, const kin::JointVector& measured, double t_set) noexcept;
+  /// The generator's setpoint q (rad / m) for time `t_set` (s); returns the motion's id (0 at
+  /// rest). Passes on what a functional transform's function throws (the session then ends
+  /// control with control_exception), hence not noexcept.
+  std::uint64_t step_generator(const rtc::How& h, const kin::JointVector& measured, double t_set,
+                               kin::JointVector& q);
+  /// Guards and compliance on q for motion `id`: a contact ends the motion (nextmove), an
+  /// overload or an unreachable offset stops it.
+  void apply_force(const rtc::How& h, std::uint64_t id, double period_s,
+                   kin::JointVector& q) noexcept;
+  /// q (rad / m) as POSVEL range values, and the motion id as the sample's segment.
+  void write_setpoints(rtc::Control& c, const kin::JointVector& q, std::uint64_t id) noexcept;
+
   /// `configuration` >= 0: the configuration this motion moves into (chosen for it).
   Motion submit(MotionRequest r, const PositionPtr& keep, const StartWhen& when,
                 std::int16_t configuration = -1);

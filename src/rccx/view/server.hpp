@@ -26,6 +26,9 @@
 //   /api/log           replay only: the whole recorded run (of robot 0: a replay is one robot's)
 //   /ws                the live samples (?robot=NAME), as JSON text messages
 // An unknown robot is a 404 with a message naming the robots there; the server goes on.
+// Inside (namespace detail): sample_feed.hpp the taps and what the server's thread makes of
+// them, page_socket.hpp a page's WebSocket, routes.hpp which URL gives what, goals.hpp the
+// frames the program adds, site.hpp what they all read.
 #pragma once
 
 #include <cstdint>
