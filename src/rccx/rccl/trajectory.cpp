@@ -9,12 +9,15 @@
 #include "rccx/io/fixed_text.hpp"
 #include "rccx/math/units.hpp"
 #include "rccx/rccl/paul_transition.hpp"
+#include "rccx/rccl/trajectory/text.hpp"
 #include "rccx/rtc/types.hpp"
 
 namespace rccx::rccl {
 namespace {
 
 using kin::JointVector;
+using trajectory::GateState;
+using trajectory::text;
 
 /// The quintic smoothstep of Lloyd and Hayward's blend: s(0) = 0, s(1) = 1, s' and s'' zero
 /// at both ends.
@@ -90,37 +93,7 @@ double distance_to_segment(const math::Vec3& p, const math::Vec3& a, const math:
   return (p - (a + ab * s)).norm();
 }
 
-/// A message made in the sample loop, by value (io::format_fixed: no allocation).
-template <class... Args>
-std::array<char, kEventText> text(fmt::format_string<Args...> f, Args&&... args) noexcept {
-  std::array<char, kEventText> to{};
-  io::format_fixed(to, f, std::forward<Args>(args)...);
-  return to;
-}
-
 }  // namespace
-
-std::string_view to_string(Mode m) noexcept {
-  return m == Mode::joint ? "joint" : "cartesian";
-}
-
-std::string_view to_string(EventKind k) noexcept {
-  switch (k) {
-    case EventKind::started:
-      return "started";
-    case EventKind::ended:
-      return "ended";
-    case EventKind::failed:
-      return "failed";
-    case EventKind::cancelled:
-      return "cancelled";
-  }
-  return "?";
-}
-
-std::string_view MotionEvent::message() const noexcept {
-  return {text.data()};
-}
 
 TrajectoryGenerator::TrajectoryGenerator(const kin::Kinematics& kinematics,
                                          GeneratorOptions options)
@@ -141,23 +114,6 @@ TrajectoryGenerator::TrajectoryGenerator(const kin::Kinematics& kinematics,
     }
   }
   reset(kin_.model().ready(), 0.0);
-}
-
-// --- Planning level ------------------------------------------------------------------------------
-
-bool TrajectoryGenerator::submit(const MotionRequest& request) noexcept {
-  return requests_.push(request);
-}
-
-std::optional<MotionEvent> TrajectoryGenerator::next_event() noexcept {
-  MotionEvent e;
-  if (events_.pop(e)) return e;
-  return std::nullopt;
-}
-
-SegmentReport TrajectoryGenerator::report(std::uint64_t id) const noexcept {
-  const SegmentReport& r = reports_[id % kReports];
-  return r.id == id ? r : SegmentReport{};
 }
 
 // --- Segment values ------------------------------------------------------------------------------
@@ -772,8 +728,8 @@ void TrajectoryGenerator::begin_transition(const SampleContext& ctx, double tB, 
   if (to_next) {
     next_.tau_in = tau;
     ledger_.mark_started(next_.id);
-    emit(EventKind::started, next_.id, ctx);
-    SegmentReport& rep = reports_[next_.id % kReports];
+    queue_.emit(EventKind::started, next_.id, ctx);
+    SegmentReport& rep = queue_.report_slot(next_.id);
     rep = SegmentReport{};
     rep.id = next_.id;
     rep.mode = next_.kind == Segment::Kind::cartesian ? Mode::cartesian : Mode::joint;
@@ -936,30 +892,15 @@ TrajectoryGenerator::Segment TrajectoryGenerator::rest_of(const Segment& a) cons
 
 // --- Ending, failing, halting --------------------------------------------------------------------
 
-void TrajectoryGenerator::emit(EventKind kind, std::uint64_t id, const SampleContext& ctx,
-                               kin::IkStatus status, int joint, std::string_view text) noexcept {
-  MotionEvent e;
-  e.kind = kind;
-  e.id = id;
-  e.t_s = ctx.t_s;
-  e.sample = ctx.sample;
-  e.status = status;
-  e.joint = joint;
-  const std::size_t len = std::min(text.size(), kEventText - 1);
-  std::copy_n(text.data(), len, e.text.data());
-  e.text[len] = '\0';
-  events_.push(e);  // a full event queue drops the event: the counters still tell the story
-}
-
 void TrajectoryGenerator::end_motion(const Segment& s, const SampleContext& ctx,
                                      std::string_view text) noexcept {
   if (s.id == 0) return;
-  SegmentReport& rep = reports_[s.id % kReports];
+  SegmentReport& rep = queue_.report_slot(s.id);
   if (rep.id == s.id) rep.end_s = ctx.t_s;
   if (s.position != nullptr && !s.borrowed_position) {
     s.position->pending_ends.fetch_sub(1, std::memory_order_acq_rel);
   }
-  emit(EventKind::ended, s.id, ctx, kin::IkStatus::ok, 0, text);
+  queue_.emit(EventKind::ended, s.id, ctx, kin::IkStatus::ok, 0, text);
   ledger_.mark_ended(s.id);
 }
 
@@ -979,15 +920,11 @@ void TrajectoryGenerator::next_motion(const SampleContext& ctx) noexcept {
     end_motion(next_, ctx, kNextmoveText);
   } else {
     if (cur_.kind != Segment::Kind::rest && !cur_.resting) end_motion(cur_, ctx, kNextmoveText);
-    if (has_next_ && joined_) {
-      // Joined but not begun: it starts from rest once the arm has stopped, before the
-      // request taken after it.
-      if (waiting_) requeued_ = waiting_;
-      waiting_ = joined_;
-      rendezvous_ready_ = false;
-    }
+    // Joined but not begun: it starts from rest once the arm has stopped, before the request
+    // taken after it.
+    if (has_next_) queue_.put_back_joined();
   }
-  joined_.reset();
+  queue_.drop_joined();
   has_next_ = false;
   tr_.active = false;
   cur_.id = 0;
@@ -996,16 +933,16 @@ void TrajectoryGenerator::next_motion(const SampleContext& ctx) noexcept {
 
 void TrajectoryGenerator::fail(std::uint64_t id, const SampleContext& ctx, kin::IkStatus status,
                                int joint, const Text& text) noexcept {
-  SegmentReport& rep = reports_[id % kReports];
+  SegmentReport& rep = queue_.report_slot(id);
   rep.id = id;
   rep.failed = true;
   rep.end_s = ctx.t_s;
-  emit(EventKind::failed, id, ctx, status, joint, std::string_view(text.data()));
+  queue_.emit(EventKind::failed, id, ctx, status, joint, std::string_view(text.data()));
   // Everything from the motion running now to the last one queued ends here.
   std::uint64_t last = id;
   const auto cancel = [&](const Segment& s) {
     if (s.id == 0) return;
-    if (s.id != id) emit(EventKind::cancelled, s.id, ctx);
+    if (s.id != id) queue_.emit(EventKind::cancelled, s.id, ctx);
     if (s.position != nullptr && !s.borrowed_position) {
       s.position->pending_ends.fetch_sub(1, std::memory_order_acq_rel);
     }
@@ -1013,20 +950,12 @@ void TrajectoryGenerator::fail(std::uint64_t id, const SampleContext& ctx, kin::
   };
   if (cur_.kind != Segment::Kind::rest) cancel(cur_);
   if (has_next_) cancel(next_);
-  const auto cancel_request = [&](const MotionRequest& r) {
+  queue_.cancel_all(text, [&](const MotionRequest& r) {
     Segment w;
     w.id = r.id;
     w.position = r.position;
     cancel(w);
-    withdraw_from(r, text);
-  };
-  if (waiting_) cancel_request(*waiting_);
-  if (requeued_) cancel_request(*requeued_);
-  waiting_.reset();
-  requeued_.reset();
-  joined_.reset();
-  MotionRequest r;
-  while (requests_.pop(r)) cancel_request(r);
+  });
   has_next_ = false;
   tr_.active = false;
   ledger_.mark_failed(id, last);
@@ -1089,55 +1018,24 @@ void TrajectoryGenerator::rest_at(const JointVector& q) noexcept {
 // --- Gates and rendezvous
 // -------------------------------------------------------------------------
 
-TrajectoryGenerator::GateState TrajectoryGenerator::gate_state(Text& why) const noexcept {
-  const MotionRequest& r = *waiting_;
-  for (std::size_t k = 0; k < r.gates; ++k) {
-    const EventGate& g = r.after[k];
-    const GateAnswer a = g.answer();
-    if (a == GateAnswer::yes) continue;
-    if (a == GateAnswer::not_yet) return GateState::closed;
-    const std::string_view robot = g.ledger != nullptr ? g.ledger->robot() : "?";
-    const char* what = g.kind == EventGate::Kind::started ? "start" : "end";
-    if (g.ledger != nullptr && g.ledger->control_ended() && !g.ledger->failed(g.id)) {
-      why = text("cancelled: it waited for the {} of {}'s motion {}, and {}'s control ended", what,
-                 robot, g.id, robot);
-    } else {
-      why = text("cancelled: it waited for the {} of {}'s motion {}, which failed or was cancelled",
-                 what, robot, g.id);
-    }
-    return GateState::cancel;
-  }
-  if (r.together != nullptr) {
-    if (const std::string_view w = r.together->withdrawn(); !w.empty()) {
-      why = text("cancelled: its joint start cannot happen: {}", w);
-      return GateState::cancel;
-    }
-    if (const MotionLedger* lost = r.together->lost_participant(); lost != nullptr) {
-      why = text("cancelled: its joint start cannot happen: {}'s control ended", lost->robot());
-      return GateState::cancel;
-    }
-  }
-  return GateState::open;
-}
-
 void TrajectoryGenerator::start_waiting(const SampleContext& ctx, double t) {
-  Rendezvous* rv = waiting_->together;
+  Rendezvous* rv = queue_.waiting()->together;
   const double eps = 1e-9;
   // Samples are for the tick's time (How); the setpoint time runs the pipeline ahead of it.
   const double now = ctx.how != nullptr ? ctx.how->time_s : t;
   if (rv != nullptr && !(rv->start_s() >= 0.0 && now >= rv->start_s() - eps)) {
-    if (rendezvous_ready_ || rv->start_s() >= 0.0) return;  // waiting for the others' or the start
+    if (queue_.rendezvous_ready() || rv->start_s() >= 0.0) return;  // the others', or the start
     // Plan as if starting now, to tell the others how long this motion takes; build again at
     // the start (a goal may move meanwhile).
-    const MotionRequest r = *waiting_;
+    const MotionRequest r = *queue_.waiting();
     if (!build(r, ctx, t)) return;  // failed: fail() withdrew it
     const double tau = transition_tau(cur_, next_, blend_between(cur_, &next_), t, ctx);
     has_next_ = false;
-    rendezvous_ready_ = true;
+    queue_.set_rendezvous_ready();
     rv->ready(r.slot, now, tau + next_.T + next_.stop_tau, options_.period_s);
     return;
   }
-  const MotionRequest r = *waiting_;
+  const MotionRequest r = *queue_.waiting();
   if (cur_.kind == Segment::Kind::cartesian && cur_.resting) {
     // Tracking the last motion's goal, which has just jumped (a varb given a new value right
     // before this move()): start from where the arm stands, not from the goal's new place.
@@ -1150,8 +1048,7 @@ void TrajectoryGenerator::start_waiting(const SampleContext& ctx, double t) {
   }
   // From rest: the transition begins now; the straight part tau later.
   if (!build(r, ctx, t)) return;
-  waiting_.reset();
-  rendezvous_ready_ = false;
+  queue_.started();
   const double tau = transition_tau(cur_, next_, blend_between(cur_, &next_), t, ctx);
   if (rv != nullptr && rv->end_together()) {
     // Slowed to the slowest: the straight part takes the time left between both transitions
@@ -1162,20 +1059,9 @@ void TrajectoryGenerator::start_waiting(const SampleContext& ctx, double t) {
   begin_transition(ctx, t + tau, tau, next_.blend_in, true);
 }
 
-void TrajectoryGenerator::withdraw_from(const MotionRequest& r, const Text& why) noexcept {
-  if (r.together == nullptr) return;
-  r.together->withdraw(std::string_view(
-      text("{}'s motion {} ended before it: {}", ledger_.robot(), r.id, why.data()).data()));
-}
-
 void TrajectoryGenerator::reset(const JointVector& q, double t_s) noexcept {
-  if (waiting_) withdraw_from(*waiting_, text("its robot's control started again"));
-  if (requeued_) withdraw_from(*requeued_, text("its robot's control started again"));
-  waiting_.reset();
-  requeued_.reset();
-  joined_.reset();
+  queue_.reset(text("its robot's control started again"));
   next_requested_.store(false);
-  rendezvous_ready_ = false;
   has_next_ = false;
   tr_ = Transition{};
   halt_ = Halt{};
@@ -1188,7 +1074,7 @@ void TrajectoryGenerator::reset(const JointVector& q, double t_s) noexcept {
 }
 
 bool TrajectoryGenerator::at_rest() const noexcept {
-  return !halt_.active && !tr_.active && !has_next_ && !waiting_ && !requeued_ &&
+  return !halt_.active && !tr_.active && !has_next_ && queue_.idle() &&
          (cur_.kind == Segment::Kind::rest || cur_.resting);
 }
 
@@ -1211,33 +1097,24 @@ std::uint64_t TrajectoryGenerator::step(const SampleContext& ctx, const JointVec
       fail(id, ctx, kin::IkStatus::ok, 0, stop_text_);
     } else if (!halt_.active && tracking) {
       // Its motion has ended already: no motion to fail, only the tracking to stop.
-      emit(EventKind::failed, 0, ctx, kin::IkStatus::ok, 0, std::string_view(stop_text_.data()));
+      queue_.emit(EventKind::failed, 0, ctx, kin::IkStatus::ok, 0,
+                  std::string_view(stop_text_.data()));
       start_halt();
     }
   }
   if (next_requested_.exchange(false, std::memory_order_acq_rel)) next_motion(ctx);
-  if (!waiting_) {
-    MotionRequest r;
-    if (requeued_) {
-      waiting_ = requeued_;
-      requeued_.reset();
-      rendezvous_ready_ = false;
-    } else if (requests_.pop(r)) {
-      waiting_ = r;
-      rendezvous_ready_ = false;
-    }
-  }
+  queue_.take();
 
   if (!halt_.active && !tr_.active) {
     const bool resting = cur_.kind == Segment::Kind::rest || cur_.resting;
-    if (resting && waiting_) {
+    if (resting && queue_.waiting() != nullptr) {
       Text why{};
-      switch (gate_state(why)) {
+      switch (queue_.gate_state(why)) {
         case GateState::open:
           start_waiting(ctx, t);
           break;
         case GateState::cancel:
-          fail(waiting_->id, ctx, kin::IkStatus::ok, 0, why);
+          fail(queue_.waiting()->id, ctx, kin::IkStatus::ok, 0, why);
           break;
         case GateState::closed:
           break;
@@ -1247,12 +1124,12 @@ std::uint64_t TrajectoryGenerator::step(const SampleContext& ctx, const JointVec
       // A gated motion joins its predecessor only when it may start already; one with a
       // rendezvous always starts from rest, where the others can wait for it.
       Text why{};
-      const bool may_join = waiting_ && waiting_->together == nullptr &&
-                            (waiting_->gates == 0 || gate_state(why) == GateState::open);
+      const MotionRequest* w = queue_.waiting();
+      const bool may_join = w != nullptr && w->together == nullptr &&
+                            (w->gates == 0 || queue_.gate_state(why) == GateState::open);
       if (!has_next_ && may_join && t < te - cur_.stop_tau - eps) {
-        if (build(*waiting_, ctx, te)) {
-          joined_ = waiting_;
-          waiting_.reset();
+        if (build(*w, ctx, te)) {
+          queue_.join();
           next_tau_ = transition_tau(cur_, next_, blend_between(cur_, &next_), te, ctx);
           // Decided late: the window must not have begun already.
           next_tau_ = std::min(next_tau_, te - t);
@@ -1327,7 +1204,7 @@ std::uint64_t TrajectoryGenerator::step(const SampleContext& ctx, const JointVec
 void TrajectoryGenerator::record(const SampleContext& ctx, const JointVector& q,
                                  const JointVector* measured) noexcept {
   if (tr_.active || halt_.active || cur_.id == 0) return;
-  SegmentReport& rep = reports_[cur_.id % kReports];
+  SegmentReport& rep = queue_.report_slot(cur_.id);
   if (rep.id != cur_.id || !pose_valid_) return;
   const double P = options_.period_s;
   // The line as it stands for the present goal: from the start to the goal, in base frame.

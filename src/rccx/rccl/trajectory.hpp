@@ -51,138 +51,31 @@
 
 #include <array>
 #include <atomic>
-#include <boost/lockfree/spsc_queue.hpp>
 #include <cstdint>
 #include <optional>
 #include <string_view>
 
 #include "rccx/kinematics/kinematics.hpp"
-#include "rccx/rccl/force_settings.hpp"
-#include "rccx/rccl/position.hpp"
 #include "rccx/rccl/motion_sync.hpp"
+#include "rccx/rccl/position.hpp"
+#include "rccx/rccl/trajectory/failure.hpp"
+#include "rccx/rccl/trajectory/motion_queue.hpp"
+#include "rccx/rccl/trajectory/requests.hpp"
 
 namespace rccx::rccl {
 
-enum class Mode : std::uint8_t { joint, cartesian };
-std::string_view to_string(Mode m) noexcept;
-
-/// What setmod / setvel / settime / setconf set; each request carries a copy.
-struct MotionSettings {
-  Mode mode = Mode::joint;
-  double translation_m_per_s = 0.1;    ///< tool speed along a segment (RCCL setvel, mm/s there)
-  double rotation_rad_per_s = 1.7453;  ///< tool rotation speed (100 deg/s, RCCL's default)
-  double segment_time_s = 0.0;         ///< > 0: the segment's duration instead of the speeds
-  double transition_time_s = 0.2;      ///< the transition to the next segment (2 tau)
-  /// Configuration to reach the goal in (an index of Kinematics::configuration_names()), or
-  /// -1 to keep the one the arm is in.
-  std::int16_t configuration = -1;
-  /// Force sensing (force_settings.hpp): end on contact, yield along tool axes.
-  ForceGuard guard;
-  Compliance compliance;
-  /// The motion's tool product TOOL (T6 to the tool frame F, m): the frame the guard's and
-  /// the compliance's axes are in. Set by Manipulator::move from the position.
-  math::Transform tool;
-  /// The cell's objects (bit i: object i) the tool may touch during this motion (a probe, a
-  /// grasp, a guarded descent): the cell's collision check lets the tool's capsules come within
-  /// the margin of them. From StartWhen::touch.
-  std::uint64_t may_touch = 0;
-};
-
-enum class RequestKind : std::uint8_t { move, dwell };
-
-/// A motion request packet (thesis figure 2.3).
-struct MotionRequest {
-  std::uint64_t id = 0;  ///< 1, 2, ... in queue order
-  RequestKind kind = RequestKind::move;
-  const Position* position = nullptr;  ///< move: kept alive by the planning level
-  MotionSettings settings;
-  double dwell_s = 0.0;  ///< dwell: how long to stay
-  /// Start only once these events have happened (gates[0 .. gates)); a gate that can no longer
-  /// open cancels the motion (and those after it) with the reason.
-  std::array<EventGate, StartWhen::kMaxGates> after{};
-  std::uint8_t gates = 0;
-  /// Start with the other participants of this rendezvous (kept alive by the planning level).
-  Rendezvous* together = nullptr;
-  std::uint8_t slot = 0;
-  [[nodiscard]] bool gated() const noexcept { return gates > 0 || together != nullptr; }
-};
-
-enum class EventKind : std::uint8_t { started, ended, failed, cancelled };
-std::string_view to_string(EventKind k) noexcept;
-
-inline constexpr std::size_t kEventText = 240;
-/// The text of the `ended` event of a motion that request_next() ended before its goal.
-inline constexpr std::string_view kNextmoveText = "ended by nextmove";
-
-/// What the generator tells the planning level.
-struct MotionEvent {
-  EventKind kind = EventKind::started;
-  std::uint64_t id = 0;
-  double t_s = 0.0;
-  std::uint64_t sample = 0;
-  kin::IkStatus status = kin::IkStatus::ok;  ///< failed: why, when the kinematics said so
-  int joint = 0;                             ///< failed: the 1-based joint concerned, or 0
-  std::array<char, kEventText> text{};       ///< failed: the message for people
-  [[nodiscard]] std::string_view message() const noexcept;
-};
-
-/// How well a segment followed its path (Cartesian segments; joint ones report times only).
-struct SegmentReport {
-  std::uint64_t id = 0;
-  Mode mode = Mode::joint;
-  double start_s = 0.0;     ///< when its transition in began
-  double end_s = 0.0;       ///< when its transition out ended
-  double duration_s = 0.0;  ///< the straight part's nominal length T
-  /// Outside transitions: the largest distance of the commanded and of the measured tool
-  /// point from the straight segment (m), and the largest angle between the measured and the
-  /// commanded approach vector (rad).
-  double max_commanded_path_error_m = 0.0;
-  double max_measured_path_error_m = 0.0;
-  double max_approach_error_rad = 0.0;
-  double peak_tool_speed_m_per_s = 0.0;  ///< commanded
-  /// Samples on the straight part (0: transitions took the whole segment, nothing to judge).
-  std::uint32_t straight_samples = 0;
-  bool failed = false;
-};
-
-struct GeneratorOptions {
-  double period_s = 0.01;
-  /// Per joint, rad/s or m/s: the fastest the generator commands (default: the model's top
-  /// speed). Segment times are planned at kPlanningSpeedFraction of it.
-  kin::JointVector max_velocity;
-  /// Per joint, rad/s^2 or m/s^2 (default: max_velocity / kDefaultAccelerationTime_s).
-  kin::JointVector max_acceleration;
-};
-
-/// A joint reaches its top speed from rest in this long under the default acceleration bound.
-inline constexpr double kDefaultAccelerationTime_s = 0.25;
-/// Segments are planned at this fraction of the joints' top speeds, leaving room for
-/// transitions and for the speed of a Cartesian line to vary along it.
-inline constexpr double kPlanningSpeedFraction = 0.9;
-/// Transitions and segment times are planned at this fraction of the acceleration bound: a
-/// Cartesian blend's joint accelerations depend on the kinematics and may exceed the linear
-/// estimate they are planned from by some percent.
-inline constexpr double kPlanningAccelerationFraction = 0.8;
-/// Transitions are checked, sample by sample, against this fraction of the joints' top speeds
-/// (the rest is room for a moving goal's prediction); the next segment is slowed while one
-/// would pass it.
-inline constexpr double kTransitionSpeedFraction = 0.98;
-/// Commanded accelerations (second differences of the setpoints) stay within the bound times
-/// 1 + this: what the sampled check of a transition cannot see between its samples.
-inline constexpr double kAccelerationTolerance = 0.1;
-
 class TrajectoryGenerator {
  public:
-  static constexpr std::size_t kQueueCapacity = 256;
-  static constexpr std::size_t kReports = 256;
+  static constexpr std::size_t kQueueCapacity = trajectory::MotionQueue::kCapacity;
+  static constexpr std::size_t kReports = trajectory::MotionQueue::kReports;
 
   TrajectoryGenerator(const kin::Kinematics& kinematics, GeneratorOptions options);
 
   // --- Planning level (one thread) ----------------------------------------------------------
   /// Queues a request; false when the queue is full.
-  bool submit(const MotionRequest& request) noexcept;
+  bool submit(const MotionRequest& request) noexcept { return queue_.submit(request); }
   /// The next event, if any.
-  std::optional<MotionEvent> next_event() noexcept;
+  std::optional<MotionEvent> next_event() noexcept { return queue_.next_event(); }
   /// Asks the loop to stop smoothly where it is and cancel everything queued.
   void request_halt() noexcept { halt_requested_.store(true, std::memory_order_release); }
   /// RCCL's nextmove (a guarded motion): ends the motion running now where the arm is. The
@@ -198,7 +91,7 @@ class TrajectoryGenerator {
   /// The robot's name in messages about gates; before the loop runs.
   void set_robot_name(std::string_view name) noexcept { ledger_.set_robot(name); }
   /// The report of motion `id`, once ended_upto() >= id (and fewer than kReports later).
-  [[nodiscard]] SegmentReport report(std::uint64_t id) const noexcept;
+  [[nodiscard]] SegmentReport report(std::uint64_t id) const noexcept { return queue_.report(id); }
 
   // --- Sample loop ---------------------------------------------------------------------------
   /// Starts at rest at q (rad / m), the arm's measured joints; queued requests stay queued.
@@ -292,7 +185,7 @@ class TrajectoryGenerator {
     double t0 = 0.0;
     kin::JointVector q0, v0, stop_time;
   };
-  using Text = std::array<char, kEventText>;
+  using Text = trajectory::Text;
 
   [[nodiscard]] double fraction(const Segment& s, double t) const noexcept;
   /// The acceleration transitions are planned at (rad/s^2 or m/s^2).
@@ -313,14 +206,9 @@ class TrajectoryGenerator {
   [[nodiscard]] Segment rest_of(const Segment& a) const noexcept;
 
   bool build(const MotionRequest& r, const SampleContext& ctx, double t_via);
-  enum class GateState : std::uint8_t { open, closed, cancel };
-  /// Whether waiting_'s gates let it start now (its rendezvous apart); cancel: why says why.
-  GateState gate_state(Text& why) const noexcept;
-  /// From rest: builds waiting_ and begins its transition in at t (through its rendezvous,
-  /// when it has one).
+  /// From rest: builds the waiting request and begins its transition in at t (through its
+  /// rendezvous, when it has one).
   void start_waiting(const SampleContext& ctx, double t);
-  /// Cancels the requests from `id` on with `why`, withdrawing them from their rendezvous.
-  void withdraw_from(const MotionRequest& r, const Text& why) noexcept;
   /// The 1-based joint whose solution jumps between drive fractions r0 and r1 of Cartesian
   /// segment s (solved as q0, q1): a singularity on the line, or (at_limit) the end of the
   /// joint's travel, where the solver turns it the other way round. 0: none.
@@ -361,9 +249,6 @@ class TrajectoryGenerator {
   void finish_transition(const SampleContext& ctx);
   bool value(const SampleContext& ctx, double t, kin::JointVector& q, kin::IkStatus& why);
 
-  void emit(EventKind kind, std::uint64_t id, const SampleContext& ctx,
-            kin::IkStatus status = kin::IkStatus::ok, int joint = 0,
-            std::string_view text = {}) noexcept;
   void end_motion(const Segment& s, const SampleContext& ctx, std::string_view text = {}) noexcept;
   /// request_next(): ends the motion running now and stops where the arm is.
   void next_motion(const SampleContext& ctx) noexcept;
@@ -379,24 +264,18 @@ class TrajectoryGenerator {
   GeneratorOptions options_;
   kin::JointVector lower_, upper_;
 
-  boost::lockfree::spsc_queue<MotionRequest, boost::lockfree::capacity<kQueueCapacity>> requests_;
-  boost::lockfree::spsc_queue<MotionEvent, boost::lockfree::capacity<4 * kQueueCapacity>> events_;
+  /// Requests in (waiting, joined, put back), events out, reports.
+  trajectory::MotionQueue queue_{ledger_};
   std::atomic<bool> halt_requested_{false};
   std::atomic<bool> next_requested_{false};
   bool stop_requested_ = false;    ///< request_stop(): same thread as step()
   std::uint64_t last_motion_ = 0;  ///< what step() returned last
   Text stop_text_{};
-  std::array<SegmentReport, kReports> reports_{};
 
   // Loop state.
   Segment cur_, next_;
   bool has_next_ = false;
-  double next_tau_ = 0.0;                 ///< half the transition from cur_ into next_, s
-  std::optional<MotionRequest> waiting_;  ///< taken from the queue, not yet built
-  /// The request next_ was built from when it joined cur_ (request_next() puts it back), and a
-  /// request put back in front of the queue.
-  std::optional<MotionRequest> joined_, requeued_;
-  bool rendezvous_ready_ = false;  ///< waiting_ has told its rendezvous it is ready
+  double next_tau_ = 0.0;  ///< half the transition from cur_ into next_, s
   Transition tr_;
   Halt halt_;
   kin::JointVector last_q_, prev_q_;  ///< the last two setpoints
