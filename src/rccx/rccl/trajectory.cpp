@@ -97,23 +97,8 @@ double distance_to_segment(const math::Vec3& p, const math::Vec3& a, const math:
 
 TrajectoryGenerator::TrajectoryGenerator(const kin::Kinematics& kinematics,
                                          GeneratorOptions options)
-    : kin_(kinematics),
-      options_(std::move(options)),
-      lower_(kinematics.model().lower()),
-      upper_(kinematics.model().upper()) {
-  const auto& joints = kin_.model().joints;
-  const std::size_t n = kin_.dof();
-  if (options_.max_velocity.size() != n) {
-    options_.max_velocity = JointVector(n);
-    for (std::size_t j = 0; j < n; ++j) options_.max_velocity[j] = joints[j].max_velocity;
-  }
-  if (options_.max_acceleration.size() != n) {
-    options_.max_acceleration = JointVector(n);
-    for (std::size_t j = 0; j < n; ++j) {
-      options_.max_acceleration[j] = options_.max_velocity[j] / kDefaultAccelerationTime_s;
-    }
-  }
-  reset(kin_.model().ready(), 0.0);
+    : model_(kinematics, std::move(options)) {
+  reset(model_.kin.model().ready(), 0.0);
 }
 
 // --- Segment values ------------------------------------------------------------------------------
@@ -160,7 +145,7 @@ bool TrajectoryGenerator::solve(const Segment& s, const math::Transform& t6,
   kin::IkOptions o;
   if (s.has_configuration) o.configuration = s.configuration;
   o.near = near;
-  const kin::IkResult r = kin_.inverse(t6, o);
+  const kin::IkResult r = model_.kin.inverse(t6, o);
   if (!r) {
     why = r.status;
     return false;
@@ -200,7 +185,7 @@ bool TrajectoryGenerator::segment_value(const Segment& s, const SampleContext& c
       // singularity the joints' rates change fast along the line).
       const double r_end = r < 0.0 ? 0.0 : 1.0;
       const double t_end = r < 0.0 ? s.ts : s.ts + s.T;
-      const double step = std::min(0.01 * s.T, 0.5 * options_.period_s);
+      const double step = std::min(0.01 * s.T, 0.5 * model_.options.period_s);
       const double t_in = r < 0.0 ? t_end + step : t_end - step;
       Pose pe, pi;
       pose_at(s, at_time(ctx, t_end), r_end, pe);
@@ -224,7 +209,7 @@ constexpr double kGoalJump_m = 2e-3;
 // -----------------------------------------------------------------------------
 
 bool TrajectoryGenerator::build(const MotionRequest& r, const SampleContext& ctx, double t_via) {
-  const std::size_t n = kin_.dof();
+  const std::size_t n = model_.kin.dof();
   Segment s;
   s.id = r.id;
   s.position = r.position;
@@ -243,7 +228,7 @@ bool TrajectoryGenerator::build(const MotionRequest& r, const SampleContext& ctx
     if (!solve(cur_, t6B, last_q_, qB, why)) qB = last_q_;
   } else {
     qB = cur_.q1;
-    t6B = kin_.forward(qB);
+    t6B = model_.kin.forward(qB);
   }
   s.q0 = qB;
 
@@ -264,8 +249,8 @@ bool TrajectoryGenerator::build(const MotionRequest& r, const SampleContext& ctx
       s.configuration = cur_.configuration;
       s.has_configuration = cur_.has_configuration;
     }
-    s.T = std::max(r.dwell_s, options_.period_s);
-    s.stop_tau = std::max(options_.period_s, 0.5 * s.settings.transition_time_s);
+    s.T = std::max(r.dwell_s, model_.options.period_s);
+    s.stop_tau = std::max(model_.options.period_s, 0.5 * s.settings.transition_time_s);
     next_ = s;
     has_next_ = true;
     return true;
@@ -280,23 +265,23 @@ bool TrajectoryGenerator::build(const MotionRequest& r, const SampleContext& ctx
            text("position {} has {} joint values, the robot {}", name, g.size(), n));
       return false;
     }
-    const int out = kin_.model().first_joint_outside_limits(g, kin::kLimitTolerance);
+    const int out = model_.kin.model().first_joint_outside_limits(g, kin::kLimitTolerance);
     if (out >= 0) {
       fail(r.id, ctx, kin::IkStatus::joint_limits, out + 1,
            text("position {}: joint {} is outside its limits", name, out + 1));
       return false;
     }
-    s.fixed_goal = kin_.forward(g);
+    s.fixed_goal = model_.kin.forward(g);
   } else {
     pos.latch(s.holds);
   }
 
   // The configuration: the one asked for, else the one the arm is in.
-  if (!kin_.configuration_names().empty()) {
+  if (!model_.kin.configuration_names().empty()) {
     s.has_configuration = true;
     s.configuration = s.settings.configuration >= 0
                           ? kin::Configuration{static_cast<std::uint8_t>(s.settings.configuration)}
-                          : kin_.configuration_of(qB);
+                          : model_.kin.configuration_of(qB);
   }
   Pose goal;
   pose_at(s, ctx, 1.0, goal);  // drive is identity so far: frame = goal
@@ -312,12 +297,13 @@ bool TrajectoryGenerator::build(const MotionRequest& r, const SampleContext& ctx
   const auto joint_time = [&](const JointVector& a, const JointVector& b, double scale) {
     for (std::size_t j = 0; j < n; ++j) {
       const double d = std::abs(b[j] - a[j]) * scale;
-      by_joints = std::max(by_joints, d / (kPlanningSpeedFraction * options_.max_velocity[j]));
+      by_joints =
+          std::max(by_joints, d / (kPlanningSpeedFraction * model_.options.max_velocity[j]));
       // Room for the transitions in and out at the acceleration bound: the part of each that
       // this segment's own velocity v = d / T causes, tau = 1.875 v / a (the smooth blend),
       // takes at most a quarter of T, leaving the rest for its neighbours' velocities.
-      by_acceleration =
-          std::max(by_acceleration, std::sqrt(4.0 * kSmoothPeak * d / planning_acceleration(j)));
+      by_acceleration = std::max(
+          by_acceleration, std::sqrt(4.0 * kSmoothPeak * d / model_.planning_acceleration(j)));
     }
   };
 
@@ -357,8 +343,8 @@ bool TrajectoryGenerator::build(const MotionRequest& r, const SampleContext& ctx
                                     static_cast<double>(k) / kChecks, q_prev, q, at_limit);
       if (jumping > 0 && at_limit) {
         const auto J = static_cast<std::size_t>(jumping - 1);
-        const bool revolute = kin_.model().joints[J].type == kin::JointType::revolute;
-        const double limit = q_prev[J] < q[J] ? lower_[J] : upper_[J];
+        const bool revolute = model_.kin.model().joints[J].type == kin::JointType::revolute;
+        const double limit = q_prev[J] < q[J] ? model_.lower[J] : model_.upper[J];
         fail(r.id, ctx, kin::IkStatus::joint_limits, jumping,
              text("the straight line to {} turns joint {} past its limit ({:.1f} {}) about "
                   "{:.0f}% of the way (the line takes the shorter way round); move in joint "
@@ -382,8 +368,8 @@ bool TrajectoryGenerator::build(const MotionRequest& r, const SampleContext& ctx
     s.q1 = q;
   }
   s.T = s.settings.segment_time_s > 0.0 ? s.settings.segment_time_s : by_speed;
-  s.T = std::max(
-      {s.T, by_joints, by_acceleration, s.settings.transition_time_s, 2.0 * options_.period_s});
+  s.T = std::max({s.T, by_joints, by_acceleration, s.settings.transition_time_s,
+                  2.0 * model_.options.period_s});
   if (s.kind == Segment::Kind::cartesian) {
     // The checks above see the line at 16 points; near a singularity the joints' speed and
     // acceleration (from the curvature of the path in joint space) peak between them. Sample
@@ -427,12 +413,12 @@ bool TrajectoryGenerator::build(const MotionRequest& r, const SampleContext& ctx
       s.T *= std::min(1.02 * k, kMaxSegmentStretch * T0 / s.T);
     }
   }
-  s.stop_tau = std::max(options_.period_s, 0.5 * s.settings.transition_time_s);
+  s.stop_tau = std::max(model_.options.period_s, 0.5 * s.settings.transition_time_s);
   for (std::size_t j = 0; j < n; ++j) {
     // The velocity at the end, where the arm stops: a Cartesian line's is not its average.
     double v = std::abs(s.q1[j] - s.q0[j]) / s.T;
     if (end_step.size() == n) v = std::max(v, std::abs(end_step[j]) / s.T);
-    s.stop_tau = std::max(s.stop_tau, kPaulPeak * v / planning_acceleration(j));
+    s.stop_tau = std::max(s.stop_tau, kPaulPeak * v / model_.planning_acceleration(j));
   }
   s.stop_tau = std::min(s.stop_tau, 0.5 * s.T);
   // As for transitions between segments (transition_tau): check the stop as the loop will run
@@ -490,7 +476,7 @@ int TrajectoryGenerator::find_jump(const Segment& s, const SampleContext& ctx, d
   // same angle a turn the other way round, and the jump's near side sits on the limit.
   constexpr double kAtLimit = 1e-2;  // rad or m
   const auto near_limit = [&](double v) {
-    return std::abs(v - lower_[J]) < kAtLimit || std::abs(v - upper_[J]) < kAtLimit;
+    return std::abs(v - model_.lower[J]) < kAtLimit || std::abs(v - model_.upper[J]) < kAtLimit;
   };
   at_limit = near_limit(lo[J]) || near_limit(hi[J]);
   return joint + 1;
@@ -540,8 +526,8 @@ double TrajectoryGenerator::transition_tau(const Segment& a, Segment& b, Blend b
 
 double TrajectoryGenerator::plan_transition(const Segment& a, Segment& b, Blend blend, double tB,
                                             const SampleContext& ctx, Peaks& pk) const {
-  const double P = options_.period_s;
-  const std::size_t n = kin_.dof();
+  const double P = model_.options.period_s;
+  const std::size_t n = model_.kin.dof();
   const Segment& owner = a.kind == Segment::Kind::rest ? b : a;
   double tau = std::max(P, 0.5 * owner.settings.transition_time_s);
   // The joint velocities either side of the via point, from values one period apart.
@@ -563,7 +549,7 @@ double TrajectoryGenerator::plan_transition(const Segment& a, Segment& b, Blend 
   const auto needed = [&] {
     double t = 0.0;
     for (std::size_t j = 0; j < n; ++j) {
-      t = std::max(t, peak * std::abs(vb[j] - va[j]) / planning_acceleration(j));
+      t = std::max(t, peak * std::abs(vb[j] - va[j]) / model_.planning_acceleration(j));
     }
     return t;
   };
@@ -578,7 +564,7 @@ double TrajectoryGenerator::plan_transition(const Segment& a, Segment& b, Blend 
   if (b.kind != Segment::Kind::rest && std::isfinite(room)) {
     double stretch = 1.0;
     for (std::size_t j = 0; j < n; ++j) {
-      const double w = planning_acceleration(j) * room / peak;  // the |dv| a's room allows
+      const double w = model_.planning_acceleration(j) * room / peak;  // the |dv| a's room allows
       if (std::abs(vb[j] - va[j]) <= w) continue;
       const double side = w + (vb[j] > 0.0 ? va[j] : -va[j]);  // b's bound on its side of 0
       if (side > 0.0) stretch = std::max(stretch, std::abs(vb[j]) / side);
@@ -638,8 +624,8 @@ void TrajectoryGenerator::add_peaks(const JointVector& q0, const JointVector& q1
                                     const JointVector& q2, double h, Peaks& pk) const noexcept {
   for (std::size_t j = 0; j < q1.size(); ++j) {
     const double acc = std::abs(q2[j] - 2.0 * q1[j] + q0[j]) / (h * h);
-    pk.acceleration = std::max(pk.acceleration, acc / options_.max_acceleration[j]);
-    pk.speed = std::max(pk.speed, std::abs(q2[j] - q1[j]) / h / options_.max_velocity[j]);
+    pk.acceleration = std::max(pk.acceleration, acc / model_.options.max_acceleration[j]);
+    pk.speed = std::max(pk.speed, std::abs(q2[j] - q1[j]) / h / model_.options.max_velocity[j]);
   }
 }
 
@@ -669,7 +655,7 @@ TrajectoryGenerator::Peaks TrajectoryGenerator::segment_peaks(const Segment& s,
     }
     return true;
   };
-  const double P = options_.period_s;
+  const double P = model_.options.period_s;
   if (every_period) {
     if (!sweep(s.ts, s.ts + s.T, P, near)) return pk;
     pk.ok = true;
@@ -689,7 +675,7 @@ TrajectoryGenerator::Peaks TrajectoryGenerator::blend_peaks(const Segment& a, co
                                                             bool to_next, Blend blend, double tB,
                                                             double tau, const JointVector& near,
                                                             const SampleContext& ctx) const {
-  const double P = options_.period_s;
+  const double P = model_.options.period_s;
   Peaks pk;
   Tangents tg;
   if (to_next && !tangents(a, b, blend, tB, near, ctx, tg)) return pk;
@@ -781,7 +767,7 @@ bool TrajectoryGenerator::value(const SampleContext& ctx, double t, JointVector&
 bool TrajectoryGenerator::tangents(const Segment& a, const Segment& b, Blend blend, double tB,
                                    const JointVector& near, const SampleContext& ctx,
                                    Tangents& out) const {
-  const double P = options_.period_s;
+  const double P = model_.options.period_s;
   if (blend == Blend::smooth_joint) {
     JointVector qa0, qa1, qb0, qb1;
     kin::IkStatus why;
@@ -851,7 +837,7 @@ bool TrajectoryGenerator::blend_value(const Segment& a, const Segment& b, bool t
     case Blend::smooth_pose: {
       Pose pa, pb;
       if (a.kind == Segment::Kind::rest) {
-        pa.t6 = kin_.forward(a.q1);
+        pa.t6 = model_.kin.forward(a.q1);
       } else {
         pose_at(a, c, drive_fraction(a, t), pa);
       }
@@ -913,7 +899,7 @@ const MotionSettings* TrajectoryGenerator::running_settings(std::uint64_t id) co
 
 void TrajectoryGenerator::next_motion(const SampleContext& ctx) noexcept {
   const bool moving = tr_.active || (cur_.kind != Segment::Kind::rest && !cur_.resting);
-  if (halt_.active || !moving) return;
+  if (halting_ || !moving) return;
   if (tr_.active && tr_.to_next) {
     // Between two motions: the one ending and the one beginning both end here.
     end_motion(cur_, ctx, kNextmoveText);
@@ -970,40 +956,13 @@ void TrajectoryGenerator::request_stop(std::string_view why) noexcept {
 }
 
 void TrajectoryGenerator::start_halt() noexcept {
-  const double P = options_.period_s;
-  halt_ = Halt{};
-  halt_.active = true;
-  halt_.t0 = last_t_;
-  halt_.q0 = last_q_;
-  halt_.v0 = last_q_;
-  halt_.stop_time = last_q_;
-  double Ts = 0.0;  // one time for all joints keeps the joint-space path straight
-  for (std::size_t j = 0; j < last_q_.size(); ++j) {
-    halt_.v0[j] = (last_q_[j] - prev_q_[j]) / P;
-    Ts = std::max(Ts, std::abs(halt_.v0[j]) / options_.max_acceleration[j]);
-  }
-  for (std::size_t j = 0; j < last_q_.size(); ++j) {
-    const double v = halt_.v0[j];
-    double stop = Ts;
-    // Stopping distance v Ts / 2; a joint that would pass its limit stops harder, at it.
-    const double room = v > 0 ? upper_[j] - last_q_[j] : last_q_[j] - lower_[j];
-    if (std::abs(v) * Ts / 2.0 > room) stop = 2.0 * std::max(room, 0.0) / std::abs(v);
-    halt_.stop_time[j] = stop;
-  }
+  halt_.start(model_, last_q_, prev_q_, last_t_);
+  halting_ = true;
 }
 
 void TrajectoryGenerator::halt_value(double t, JointVector& q) noexcept {
-  q = halt_.q0;
-  bool moving = false;
-  for (std::size_t j = 0; j < q.size(); ++j) {
-    const double Ts = halt_.stop_time[j];
-    if (!(Ts > 0.0)) continue;
-    const double dt = std::min(t - halt_.t0, Ts);
-    q[j] += halt_.v0[j] * (dt - dt * dt / (2.0 * Ts));
-    moving = moving || t - halt_.t0 < Ts;
-  }
-  if (!moving) {
-    halt_.active = false;
+  if (!halt_.value(t, q)) {
+    halting_ = false;
     rest_at(q);
   }
 }
@@ -1032,7 +991,7 @@ void TrajectoryGenerator::start_waiting(const SampleContext& ctx, double t) {
     const double tau = transition_tau(cur_, next_, blend_between(cur_, &next_), t, ctx);
     has_next_ = false;
     queue_.set_rendezvous_ready();
-    rv->ready(r.slot, now, tau + next_.T + next_.stop_tau, options_.period_s);
+    rv->ready(r.slot, now, tau + next_.T + next_.stop_tau, model_.options.period_s);
     return;
   }
   const MotionRequest r = *queue_.waiting();
@@ -1064,24 +1023,25 @@ void TrajectoryGenerator::reset(const JointVector& q, double t_s) noexcept {
   next_requested_.store(false);
   has_next_ = false;
   tr_ = Transition{};
-  halt_ = Halt{};
+  halt_ = trajectory::Halt{};
+  halting_ = false;
   halt_requested_.store(false);
   stop_requested_ = false;
   last_motion_ = 0;
   rest_at(q);
   last_q_ = prev_q_ = q;
-  last_t_ = t_s - options_.period_s;
+  last_t_ = t_s - model_.options.period_s;
 }
 
 bool TrajectoryGenerator::at_rest() const noexcept {
-  return !halt_.active && !tr_.active && !has_next_ && queue_.idle() &&
+  return !halting_ && !tr_.active && !has_next_ && queue_.idle() &&
          (cur_.kind == Segment::Kind::rest || cur_.resting);
 }
 
 std::uint64_t TrajectoryGenerator::step(const SampleContext& ctx, const JointVector* measured,
                                         JointVector& q) {
   const double t = ctx.t_s;
-  const double P = options_.period_s;
+  const double P = model_.options.period_s;
   const double eps = 1e-9;
   pose_valid_ = false;
 
@@ -1092,10 +1052,10 @@ std::uint64_t TrajectoryGenerator::step(const SampleContext& ctx, const JointVec
   if (stop_requested_) {
     stop_requested_ = false;
     const bool tracking = cur_.kind == Segment::Kind::cartesian && cur_.resting;
-    if (!halt_.active && !at_rest()) {
+    if (!halting_ && !at_rest()) {
       const std::uint64_t id = cur_.id != 0 ? cur_.id : (has_next_ ? next_.id : 0);
       fail(id, ctx, kin::IkStatus::ok, 0, stop_text_);
-    } else if (!halt_.active && tracking) {
+    } else if (!halting_ && tracking) {
       // Its motion has ended already: no motion to fail, only the tracking to stop.
       queue_.emit(EventKind::failed, 0, ctx, kin::IkStatus::ok, 0,
                   std::string_view(stop_text_.data()));
@@ -1105,7 +1065,7 @@ std::uint64_t TrajectoryGenerator::step(const SampleContext& ctx, const JointVec
   if (next_requested_.exchange(false, std::memory_order_acq_rel)) next_motion(ctx);
   queue_.take();
 
-  if (!halt_.active && !tr_.active) {
+  if (!halting_ && !tr_.active) {
     const bool resting = cur_.kind == Segment::Kind::rest || cur_.resting;
     if (resting && queue_.waiting() != nullptr) {
       Text why{};
@@ -1145,7 +1105,7 @@ std::uint64_t TrajectoryGenerator::step(const SampleContext& ctx, const JointVec
   if (tr_.active && t >= tr_.tB + tr_.tau - eps) finish_transition(ctx);
 
   kin::IkStatus why = kin::IkStatus::ok;
-  if (halt_.active) {
+  if (halting_) {
     halt_value(t, q);
   } else if (!value(ctx, t, q, why)) {
     const std::uint64_t id = tr_.active && tr_.to_next ? next_.id : cur_.id;
@@ -1158,10 +1118,10 @@ std::uint64_t TrajectoryGenerator::step(const SampleContext& ctx, const JointVec
     for (std::size_t j = 0; j < q.size(); ++j) {
       const double speed = std::abs(q[j] - last_q_[j]) / P;
       const double accel = std::abs((q[j] - last_q_[j]) - (last_q_[j] - prev_q_[j])) / (P * P);
-      const bool out =
-          !(q[j] >= lower_[j] - kin::kLimitTolerance && q[j] <= upper_[j] + kin::kLimitTolerance);
-      const bool fast = !(speed <= options_.max_velocity[j] * (1.0 + 1e-6));
-      const bool jerky = !(accel <= kAccelerationGuard * options_.max_acceleration[j]);
+      const bool out = !(q[j] >= model_.lower[j] - kin::kLimitTolerance &&
+                         q[j] <= model_.upper[j] + kin::kLimitTolerance);
+      const bool fast = !(speed <= model_.options.max_velocity[j] * (1.0 + 1e-6));
+      const bool jerky = !(accel <= kAccelerationGuard * model_.options.max_acceleration[j]);
       if (out || fast || jerky) {
         const std::uint64_t id = tr_.active && tr_.to_next ? next_.id : cur_.id;
         const int joint = static_cast<int>(j) + 1;
@@ -1180,19 +1140,20 @@ std::uint64_t TrajectoryGenerator::step(const SampleContext& ctx, const JointVec
           fail(id, ctx, kin::IkStatus::singular, joint,
                text("joint {} would move at {:.3f}/s, above its top speed {:.3f}/s at t = {:.3f} "
                     "s (the path passes near a singularity?)",
-                    joint, speed, options_.max_velocity[j], t));
+                    joint, speed, model_.options.max_velocity[j], t));
         } else {
           fail(id, ctx, kin::IkStatus::singular, joint,
                text("joint {} would accelerate at {:.1f}/s^2, {:.1f} times its bound, at t = "
                     "{:.3f} s (the path passes near a singularity, or its goal jumped)",
-                    joint, accel, accel / options_.max_acceleration[j], t));
+                    joint, accel, accel / model_.options.max_acceleration[j], t));
         }
         halt_value(t, q);
         break;
       }
     }
   }
-  for (std::size_t j = 0; j < q.size(); ++j) q[j] = std::clamp(q[j], lower_[j], upper_[j]);
+  for (std::size_t j = 0; j < q.size(); ++j)
+    q[j] = std::clamp(q[j], model_.lower[j], model_.upper[j]);
   record(ctx, q, measured);
   prev_q_ = last_q_;
   last_q_ = q;
@@ -1203,10 +1164,10 @@ std::uint64_t TrajectoryGenerator::step(const SampleContext& ctx, const JointVec
 
 void TrajectoryGenerator::record(const SampleContext& ctx, const JointVector& q,
                                  const JointVector* measured) noexcept {
-  if (tr_.active || halt_.active || cur_.id == 0) return;
+  if (tr_.active || halting_ || cur_.id == 0) return;
   SegmentReport& rep = queue_.report_slot(cur_.id);
   if (rep.id != cur_.id || !pose_valid_) return;
-  const double P = options_.period_s;
+  const double P = model_.options.period_s;
   // The line as it stands for the present goal: from the start to the goal, in base frame.
   const math::Vec3 from =
       cur_.fixed_start ? cur_.start_world.p : (pose_.goal * cur_.start_in_goal).p;
@@ -1222,7 +1183,7 @@ void TrajectoryGenerator::record(const SampleContext& ctx, const JointVector& q,
   // transition in is that far behind.
   if (measured != nullptr && measured->size() == q.size() &&
       ctx.t_s >= cur_.ts + cur_.tau_in + 3.0 * P) {
-    const math::Transform frame = kin_.forward(*measured) * pose_.tool;
+    const math::Transform frame = model_.kin.forward(*measured) * pose_.tool;
     rep.max_measured_path_error_m =
         std::max(rep.max_measured_path_error_m, distance_to_segment(frame.p, from, to));
     const double c = std::clamp(dot(frame.R.a, pose_.frame.R.a), -1.0, 1.0);

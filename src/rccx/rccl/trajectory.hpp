@@ -59,6 +59,8 @@
 #include "rccx/rccl/motion_sync.hpp"
 #include "rccx/rccl/position.hpp"
 #include "rccx/rccl/trajectory/failure.hpp"
+#include "rccx/rccl/trajectory/halt.hpp"
+#include "rccx/rccl/trajectory/model.hpp"
 #include "rccx/rccl/trajectory/motion_queue.hpp"
 #include "rccx/rccl/trajectory/requests.hpp"
 
@@ -107,8 +109,8 @@ class TrajectoryGenerator {
   [[nodiscard]] const MotionSettings* running_settings(std::uint64_t id) const noexcept;
   /// The id the last step() returned: the motion the last setpoint belongs to (0 at rest).
   [[nodiscard]] std::uint64_t last_motion() const noexcept { return last_motion_; }
-  [[nodiscard]] const kin::Kinematics& kinematics() const noexcept { return kin_; }
-  [[nodiscard]] const GeneratorOptions& options() const noexcept { return options_; }
+  [[nodiscard]] const kin::Kinematics& kinematics() const noexcept { return model_.kin; }
+  [[nodiscard]] const GeneratorOptions& options() const noexcept { return model_.options; }
 
   // --- Sample loop, between steps (the control thread only: f2, a SessionGroup cycle hook) --
   /// The last setpoint step() returned (rad / m; empty before the first reset) and the one
@@ -180,18 +182,9 @@ class TrajectoryGenerator {
     double tB = 0.0, tau = 0.0;
     Blend blend = Blend::paul_joint;
   };
-  struct Halt {
-    bool active = false;
-    double t0 = 0.0;
-    kin::JointVector q0, v0, stop_time;
-  };
   using Text = trajectory::Text;
 
   [[nodiscard]] double fraction(const Segment& s, double t) const noexcept;
-  /// The acceleration transitions are planned at (rad/s^2 or m/s^2).
-  [[nodiscard]] double planning_acceleration(std::size_t j) const noexcept {
-    return kPlanningAccelerationFraction * options_.max_acceleration[j];
-  }
   [[nodiscard]] double drive_fraction(const Segment& s, double t) const noexcept {
     return s.resting ? 1.0 : fraction(s, t);
   }
@@ -260,9 +253,7 @@ class TrajectoryGenerator {
   void record(const SampleContext& ctx, const kin::JointVector& q,
               const kin::JointVector* measured) noexcept;
 
-  const kin::Kinematics& kin_;
-  GeneratorOptions options_;
-  kin::JointVector lower_, upper_;
+  const trajectory::GeneratorModel model_;
 
   /// Requests in (waiting, joined, put back), events out, reports.
   trajectory::MotionQueue queue_{ledger_};
@@ -277,7 +268,8 @@ class TrajectoryGenerator {
   bool has_next_ = false;
   double next_tau_ = 0.0;  ///< half the transition from cur_ into next_, s
   Transition tr_;
-  Halt halt_;
+  trajectory::Halt halt_;
+  bool halting_ = false;              ///< halt_ runs
   kin::JointVector last_q_, prev_q_;  ///< the last two setpoints
   MotionLedger ledger_;               ///< beside last_q_: a cell's cycle hook reads both every tick
   double last_t_ = 0.0;
