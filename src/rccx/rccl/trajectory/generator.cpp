@@ -1,6 +1,7 @@
 #include "rccx/rccl/trajectory/generator.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 
 #include "rccx/rccl/trajectory/setpoint_guard.hpp"
@@ -34,13 +35,14 @@ TrajectoryGenerator::TrajectoryGenerator(const kin::Kinematics& kinematics,
 
 std::uint64_t TrajectoryGenerator::step(const SampleContext& ctx, const JointVector* measured,
                                         JointVector& q) {
+  assert(phase_consistent());
   pose_valid_ = false;
   handle_stops(ctx);  // halt(), request_stop(), nextmove: fail or end what moves, then halt
   queue_.take();      // the next request, when none waits
   schedule(ctx);      // start from rest, join the next segment, begin the transition that is due
   const trajectory::Transition& tr = loop_.tr;
-  if (loop_.in_transition && ctx.t_s >= tr.tB + tr.tau - 1e-9) finish_transition(ctx);
-  if (evaluate(ctx, q)) guard(ctx, q);  // the setpoint; a failure halts the arm
+  if (loop_.phase == Phase::transition && ctx.t_s >= tr.tB + tr.tau - 1e-9) finish_transition(ctx);
+  if (evaluate(ctx, q)) guard(ctx, q);  // the phase's setpoint; a failure halts the arm
   trajectory::clamp_to_limits(model_, q);
   record(ctx, q, measured);  // the path report
   loop_.prev_q = loop_.last_q;
@@ -56,10 +58,9 @@ void TrajectoryGenerator::handle_stops(const SampleContext& ctx) noexcept {
   }
   if (stop_requested_) {
     stop_requested_ = false;
-    const bool tracking = loop_.cur.kind == Segment::Kind::cartesian && loop_.cur.resting;
-    if (!loop_.halting && !at_rest()) {
+    if (loop_.phase != Phase::halting && !at_rest()) {
       fail(moving_id(), ctx, kin::IkStatus::ok, 0, stop_text_);
-    } else if (!loop_.halting && tracking) {
+    } else if (loop_.phase == Phase::tracking) {
       // Its motion has ended already: no motion to fail, only the tracking to stop.
       queue_.emit(EventKind::failed, 0, ctx, kin::IkStatus::ok, 0,
                   std::string_view(stop_text_.data()));
@@ -70,12 +71,17 @@ void TrajectoryGenerator::handle_stops(const SampleContext& ctx) noexcept {
 }
 
 void TrajectoryGenerator::schedule(const SampleContext& ctx) {
-  if (loop_.halting || loop_.in_transition) return;
-  const bool resting = loop_.cur.kind == Segment::Kind::rest || loop_.cur.resting;
-  if (resting && queue_.waiting() != nullptr) {
-    start_or_cancel(ctx);
-  } else if (!resting) {
-    join_or_end(ctx);
+  switch (loop_.phase) {
+    case Phase::rest:
+    case Phase::tracking:
+      if (queue_.waiting() != nullptr) start_or_cancel(ctx);
+      return;
+    case Phase::segment:
+      join_or_end(ctx);
+      return;
+    case Phase::transition:
+    case Phase::halting:
+      return;
   }
 }
 
@@ -123,7 +129,7 @@ void TrajectoryGenerator::join_or_end(const SampleContext& ctx) {
 bool TrajectoryGenerator::evaluate(const SampleContext& ctx, JointVector& q) {
   const double t = ctx.t_s;
   kin::IkStatus why = kin::IkStatus::ok;
-  if (loop_.halting) {
+  if (loop_.phase == Phase::halting) {
     halt_value(t, q);
     return false;
   }
@@ -139,10 +145,10 @@ bool TrajectoryGenerator::evaluate(const SampleContext& ctx, JointVector& q) {
 bool TrajectoryGenerator::value(const SampleContext& ctx, double t, JointVector& q,
                                 kin::IkStatus& why) {
   const Segment& cur = loop_.cur;
-  if (!loop_.in_transition) {
+  if (loop_.phase != Phase::transition) {
     trajectory::Pose p;
     const bool ok = segments_.value(cur, ctx, t, loop_.last_q, q, why, &p);
-    if (ok && cur.kind == Segment::Kind::cartesian && !cur.resting) {
+    if (ok && loop_.phase == Phase::segment && cur.kind == Segment::Kind::cartesian) {
       pose_ = p;
       pose_valid_ = true;
     }
@@ -164,7 +170,7 @@ void TrajectoryGenerator::guard(const SampleContext& ctx, JointVector& q) noexce
 void TrajectoryGenerator::record(const SampleContext& ctx, const JointVector& q,
                                  const JointVector* measured) noexcept {
   const Segment& cur = loop_.cur;
-  if (loop_.in_transition || loop_.halting || cur.id == 0) return;
+  if (loop_.phase != Phase::segment || cur.id == 0) return;
   SegmentReport& rep = queue_.report_slot(cur.id);
   if (rep.id != cur.id || !pose_valid_) return;
   const double P = model_.options.period_s;
@@ -215,7 +221,7 @@ void TrajectoryGenerator::start_waiting(const SampleContext& ctx, double t) {
     return;
   }
   const MotionRequest r = *queue_.waiting();
-  if (loop_.cur.kind == Segment::Kind::cartesian && loop_.cur.resting) {
+  if (loop_.phase == Phase::tracking) {
     // Tracking the last motion's goal, which has just jumped (a varb given a new value right
     // before this move()): start from where the arm stands, not from the goal's new place.
     // (Evaluating the goal for this sample is what records its step in goal_track_.)
@@ -256,10 +262,10 @@ void TrajectoryGenerator::tell_rendezvous(const SampleContext& ctx, double t, do
 void TrajectoryGenerator::begin_transition(const SampleContext& ctx, double tB, double tau,
                                            trajectory::Blend blend, bool to_next) {
   trajectory::Transition tr{blend, to_next, tB, tau, {}};
-  // Before the transition runs: the goals the tangents evaluate are still cur's (GoalTrack).
+  // Before the phase changes: the goals the tangents evaluate are still cur's (GoalTrack).
   if (to_next) blends_.tangents(loop_.cur, loop_.next, loop_.last_q, ctx, tr);
   loop_.tr = tr;
-  loop_.in_transition = true;
+  loop_.phase = Phase::transition;
   have_last_frame_ = false;
   if (!to_next) return;
   Segment& next = loop_.next;
@@ -275,7 +281,8 @@ void TrajectoryGenerator::begin_transition(const SampleContext& ctx, double tB, 
 }
 
 void TrajectoryGenerator::finish_transition(const SampleContext& ctx) {
-  loop_.in_transition = false;
+  // On cur until what follows is decided: the present segment is cur (GoalTrack).
+  loop_.phase = Phase::segment;
   Segment& cur = loop_.cur;
   if (loop_.tr.to_next) {
     end_motion(cur, ctx);
@@ -288,6 +295,7 @@ void TrajectoryGenerator::finish_transition(const SampleContext& ctx) {
   if (cur.kind == Segment::Kind::cartesian && cur.position->moves()) {
     cur.resting = true;
     cur.id = 0;
+    loop_.phase = Phase::tracking;
     return;
   }
   JointVector q = cur.q1;
@@ -313,22 +321,20 @@ void TrajectoryGenerator::end_motion(const Segment& s, const SampleContext& ctx,
 }
 
 void TrajectoryGenerator::next_motion(const SampleContext& ctx) noexcept {
-  const Segment& cur = loop_.cur;
-  const bool moving = loop_.in_transition || (cur.kind != Segment::Kind::rest && !cur.resting);
-  if (loop_.halting || !moving) return;
-  if (loop_.in_transition && loop_.tr.to_next) {
+  const Phase phase = loop_.phase;
+  if (phase != Phase::segment && phase != Phase::transition) return;  // nothing moves
+  if (phase == Phase::transition && loop_.tr.to_next) {
     // Between two motions: the one ending and the one beginning both end here.
     end_motion(loop_.cur, ctx, kNextmoveText);
     end_motion(loop_.next, ctx, kNextmoveText);
   } else {
-    if (cur.kind != Segment::Kind::rest && !cur.resting) end_motion(cur, ctx, kNextmoveText);
+    end_motion(loop_.cur, ctx, kNextmoveText);  // on its straight part or stopping at its end
     // Joined but not begun: it starts from rest once the arm has stopped, before the request
     // taken after it.
     if (loop_.has_next) queue_.put_back_joined();
   }
   queue_.drop_joined();
   loop_.has_next = false;
-  loop_.in_transition = false;
   loop_.cur.id = 0;
   start_halt();
 }
@@ -353,7 +359,6 @@ void TrajectoryGenerator::fail(std::uint64_t id, const SampleContext& ctx, kin::
   if (loop_.has_next) cancel(loop_.next.id, loop_.next.position, loop_.next.borrowed_position);
   queue_.cancel_all(text, [&](const MotionRequest& r) { cancel(r.id, r.position, false); });
   loop_.has_next = false;
-  loop_.in_transition = false;
   ledger_.mark_failed(id, last);
   start_halt();
 }
@@ -365,20 +370,18 @@ std::uint64_t TrajectoryGenerator::moving_id() const noexcept {
 
 void TrajectoryGenerator::start_halt() noexcept {
   loop_.halt.start(model_, loop_.last_q, loop_.prev_q, loop_.last_t);
-  loop_.halting = true;
+  loop_.phase = Phase::halting;
 }
 
 void TrajectoryGenerator::halt_value(double t, JointVector& q) noexcept {
-  if (!loop_.halt.value(t, q)) {
-    loop_.halting = false;
-    rest_at(q);
-  }
+  if (!loop_.halt.value(t, q)) rest_at(q);
 }
 
 void TrajectoryGenerator::rest_at(const JointVector& q) noexcept {
   loop_.cur = Segment{};
   loop_.cur.kind = Segment::Kind::rest;
   loop_.cur.q1 = q;
+  loop_.phase = Phase::rest;
   pose_valid_ = false;
 }
 
@@ -389,9 +392,7 @@ void TrajectoryGenerator::reset(const JointVector& q, double t_s) noexcept {
   next_requested_.store(false);
   loop_.has_next = false;
   loop_.tr = trajectory::Transition{};
-  loop_.in_transition = false;
   loop_.halt = trajectory::Halt{};
-  loop_.halting = false;
   halt_requested_.store(false);
   stop_requested_ = false;
   last_motion_ = 0;
@@ -401,8 +402,7 @@ void TrajectoryGenerator::reset(const JointVector& q, double t_s) noexcept {
 }
 
 bool TrajectoryGenerator::at_rest() const noexcept {
-  return !loop_.halting && !loop_.in_transition && !loop_.has_next && queue_.idle() &&
-         (loop_.cur.kind == Segment::Kind::rest || loop_.cur.resting);
+  return loop_.resting() && !loop_.has_next && queue_.idle();
 }
 
 const MotionSettings* TrajectoryGenerator::running_settings(std::uint64_t id) const noexcept {
@@ -415,6 +415,23 @@ const MotionSettings* TrajectoryGenerator::running_settings(std::uint64_t id) co
 void TrajectoryGenerator::request_stop(std::string_view why) noexcept {
   io::copy_fixed(stop_text_, why);
   stop_requested_ = true;
+}
+
+bool TrajectoryGenerator::phase_consistent() const noexcept {
+  const Segment& c = loop_.cur;
+  switch (loop_.phase) {
+    case Phase::rest:
+      return c.kind == Segment::Kind::rest && !c.resting && !loop_.has_next;
+    case Phase::tracking:
+      return c.kind == Segment::Kind::cartesian && c.resting && !loop_.has_next;
+    case Phase::segment:
+      return c.kind != Segment::Kind::rest && !c.resting;
+    case Phase::transition:
+      return loop_.has_next == loop_.tr.to_next;
+    case Phase::halting:
+      return !loop_.has_next;
+  }
+  return false;
 }
 
 }  // namespace rccx::rccl

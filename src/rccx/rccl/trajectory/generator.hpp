@@ -11,8 +11,8 @@
 //   }
 //
 // The state lives in a constant GeneratorModel (model.hpp), the loop's LoopState (loop_state.hpp:
-// the segments, the transition, the halt) and the MotionQueue (motion_queue.hpp); the
-// evaluator, the blends, the planner and the builder read them.
+// an explicit Phase, the segments, the transition, the halt) and the MotionQueue
+// (motion_queue.hpp); the evaluator, the blends, the planner and the builder read them.
 #pragma once
 
 #include <atomic>
@@ -94,6 +94,7 @@ class TrajectoryGenerator {
 
  private:
   using Segment = trajectory::Segment;
+  using Phase = trajectory::Phase;
   using Text = trajectory::Text;
 
   // The steps of a sample, in the order step() runs them.
@@ -101,7 +102,7 @@ class TrajectoryGenerator {
   void schedule(const SampleContext& ctx);
   void start_or_cancel(const SampleContext& ctx);
   void join_or_end(const SampleContext& ctx);
-  /// The setpoint at ctx.t_s; false when it is the halt's (nothing to guard).
+  /// The phase's setpoint at ctx.t_s; false when it is the halt's (nothing to guard).
   bool evaluate(const SampleContext& ctx, kin::JointVector& q);
   bool value(const SampleContext& ctx, double t, kin::JointVector& q, kin::IkStatus& why);
   void guard(const SampleContext& ctx, kin::JointVector& q) noexcept;
@@ -134,6 +135,8 @@ class TrajectoryGenerator {
   void start_halt() noexcept;
   void halt_value(double t, kin::JointVector& q) noexcept;
   void rest_at(const kin::JointVector& q) noexcept;
+  /// The phase invariants that let it stand for the old flags (assert only).
+  [[nodiscard]] bool phase_consistent() const noexcept;
 
   const trajectory::GeneratorModel model_;
   trajectory::MotionQueue queue_{ledger_};
