@@ -1,6 +1,6 @@
 // The trajectory generator (thesis 2.4.2, RCCL's setpoint): the RTC control function that turns
-// the queue of motion requests into one joint setpoint per sample. trajectory.hpp describes the
-// algorithm; this class is the page of steps a sample runs through, over the folder's parts:
+// the queue of motion requests into one joint setpoint per sample. docs/TRAJECTORY.md describes
+// the algorithm; this class is the page of steps a sample runs through, over the folder's parts:
 //
 //   TrajectoryGenerator gen(kinematics, {.period_s = 0.01});
 //   gen.reset(q_measured, t0);                    // at rest where the arm is

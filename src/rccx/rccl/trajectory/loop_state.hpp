@@ -1,7 +1,7 @@
 // The sample loop's data (Pinocchio's manner: the data the loop changes, apart from the constant
 // model): the phase the arm is in, the segment running and the one planned after it, the
 // transition, the halt, the last two setpoints. The generator owns it; the evaluator, the blends
-// and the planners read it. The phases follow each other so:
+// and the planners read it. The phases follow each other so (docs/TRAJECTORY.md has the figure):
 //
 //   rest -> transition -> segment -> transition -> segment ... -> transition (to rest) -> rest
 //   (or tracking a moving goal); failure, halt, nextmove, stop request -> halting -> rest

@@ -1,6 +1,6 @@
 // What passes between the planning level and the trajectory generator: the motion requests in
 // (thesis figure 2.3), the events and the path reports out, the generator's options and the
-// fractions of the joints' bounds it plans at. Plain data; trajectory.hpp tells the story.
+// fractions of the joints' bounds it plans at. Plain data; docs/TRAJECTORY.md tells the story.
 //
 //   rccl::MotionRequest r;                    // a move: a position and the settings to use
 //   r.id = 1;

@@ -2,7 +2,7 @@
 // A segment is a rest (the arm stays at q1), a joint segment (the joints on a straight line from
 // q0 to q1) or a Cartesian one (the tool frame F = G D(r): the goal G evaluated at that time,
 // Paul's drive transform D at the fraction r of the straight part, the inverse kinematics in the
-// segment's configuration). trajectory.hpp describes the whole.
+// segment's configuration). docs/TRAJECTORY.md describes the whole.
 //
 //   const SegmentEvaluator segments(model, loop, goals);  // reads the model and the loop's state
 //   kin::IkStatus why;
