@@ -195,85 +195,92 @@ void MicroboDriver::read(double t_s, How& how) noexcept {
   JointVector q(n);
   bool all_calibrated = true;
   for (std::size_t j = 0; j < n; ++j) {
-    JointState& s = joints_[j];
-    const hw::RcuJointConfig& c = config_.joints[j];
-    std::uint16_t flags = 0;
-    std::uint8_t status = 0;
-    std::uint16_t e = 0;
-    s.error = get_byte(j, rcu::kGetStatus, status);
-    if (s.error == BusError::ok) s.error = get_word(j, rcu::kGetPosition, e);
-    if (s.error != BusError::ok) {
-      how.joint[j].flags = kNotAnswering;  // q stays as last read
-      q[j] = how.joint[j].q;
-      all_calibrated = false;
-      continue;
-    }
-    const bool initialized = (status & hw::kStatusInitialized) != 0;
-    const bool just_initialized = initialized && s.calibrating && !s.returning;
-    if (just_initialized) s.area = 0;  // INITIALIZE done at the stop: that is area 0
-    const bool restarted = reads_ == 0 || initialized != s.initialized;
-    s.initialized = initialized;
-    if (restarted) s.set_up = false;  // INITIALIZE restores the vendor's defaults
-    if ((status & hw::kStatusEncoderError) != 0) flags |= kEncoderError;
-    if ((status & hw::kStatusPhaseError) != 0) flags |= kPhaseError;
-    if ((status & hw::kStatusFault) != 0) flags |= kJointFault;
-    const double before = s.measured;
-    s.measured = e + static_cast<double>(hw::kWorkAreaShift) * s.area;
-    // Work areas (figure 4.4): past a threshold the joint changes area, which it accepts there;
-    // the absolute count stays, the register moves by 50000.
-    if (c.work_areas && initialized) {
-      if (e > c.upper_threshold && put_cmd(j, rcu::kChangeWorkArea) == BusError::ok) ++s.area;
-      if (e < c.lower_threshold && put_cmd(j, rcu::kChangeWorkArea) == BusError::ok) --s.area;
-    }
-    if (restarted) {  // nothing commanded yet: hold where the joint is
-      s.desired = s.measured;
-      s.following = false;
-    }
-    if (just_initialized) {
-      // The stop lies outside the joint's range: calibration ends back inside it, at the lower
-      // limit plus the stop's margin, at the speed INITIALIZE sought the stop with.
-      const kin::Joint& m = model_.joints[j];
-      s.returning = true;
-      s.goal = counts_of(j, m.lower + config_.joints[j].hard_stop_margin);
-      s.rate = 0.1 * m.max_velocity / m.resolution_per_count;
-      s.following = true;
-    }
-    if (s.returning && !s.following && std::abs(s.measured - s.goal) <= kSettledCounts &&
-        std::abs(s.measured - before) <= kStillCounts) {
-      s.returning = false;
-      s.calibrating = false;
-    }
-    q[j] = joint_value_of(j, s.measured);
-    if (initialized) flags |= kCalibrated;
-    if (s.calibrating) flags |= kCalibrating;
-    if (reads_ > 0 && restarted) velocity_.restart(j, q[j]);
-    all_calibrated = all_calibrated && initialized;
-    how.joint[j].q = q[j];
-    how.joint[j].flags = flags;
+    all_calibrated = read_joint(j, how.joint[j]) && all_calibrated;
+    q[j] = how.joint[j].q;  // as last read when the joint did not answer
   }
   const JointVector v = velocity_.update(t_s, q);
   for (std::size_t j = 0; j < n; ++j) how.joint[j].velocity = v[j];
   ++reads_;
-  if (examine_ >= 0) {  // the motor parameters, read back from the joint micro's RAM
-    const auto j = static_cast<std::size_t>(examine_);
-    examine_ = -1;
-    BusError e = BusError::ok;
-    for (std::size_t i = 0; i < 16 && e == BusError::ok; i += 2) {
-      std::uint16_t word = 0;
-      e = put_word(j, rcu::kSetRamPointer,
-                   static_cast<std::uint16_t>(hw::kRcuMotorParameterRam + i));
-      if (e == BusError::ok) e = get_word(j, rcu::kReadRamWord, word);
-      examined_parameters_[i] = static_cast<std::uint8_t>(word & 0xff);
-      examined_parameters_[i + 1] = static_cast<std::uint8_t>(word >> 8);
-    }
-    examined_ = e == BusError::ok ? static_cast<std::int8_t>(j) : std::int8_t{-1};
-  }
+  if (examine_ >= 0) read_motor_parameters();
   how.examined_joint = examined_;
   how.motor_parameters = examined_parameters_;
   how.all_calibrated = all_calibrated;
   how.power = relays_.power();
   how.hand_closed = relays_.hand_closed();
   how.outputs = relays_.outputs();
+}
+
+bool MicroboDriver::read_joint(std::size_t j, JointHow& out) noexcept {
+  JointState& s = joints_[j];
+  const hw::RcuJointConfig& c = config_.joints[j];
+  std::uint16_t flags = 0;
+  std::uint8_t status = 0;
+  std::uint16_t e = 0;
+  s.error = get_byte(j, rcu::kGetStatus, status);
+  if (s.error == BusError::ok) s.error = get_word(j, rcu::kGetPosition, e);
+  if (s.error != BusError::ok) {
+    out.flags = kNotAnswering;  // q stays as last read
+    return false;
+  }
+  const bool initialized = (status & hw::kStatusInitialized) != 0;
+  const bool just_initialized = initialized && s.calibrating && !s.returning;
+  if (just_initialized) s.area = 0;  // INITIALIZE done at the stop: that is area 0
+  const bool restarted = reads_ == 0 || initialized != s.initialized;
+  s.initialized = initialized;
+  if (restarted) s.set_up = false;  // INITIALIZE restores the vendor's defaults
+  if ((status & hw::kStatusEncoderError) != 0) flags |= kEncoderError;
+  if ((status & hw::kStatusPhaseError) != 0) flags |= kPhaseError;
+  if ((status & hw::kStatusFault) != 0) flags |= kJointFault;
+  const double before = s.measured;
+  s.measured = e + static_cast<double>(hw::kWorkAreaShift) * s.area;
+  // Work areas (figure 4.4): past a threshold the joint changes area, which it accepts there;
+  // the absolute count stays, the register moves by 50000.
+  if (c.work_areas && initialized) {
+    if (e > c.upper_threshold && put_cmd(j, rcu::kChangeWorkArea) == BusError::ok) ++s.area;
+    if (e < c.lower_threshold && put_cmd(j, rcu::kChangeWorkArea) == BusError::ok) --s.area;
+  }
+  if (restarted) {  // nothing commanded yet: hold where the joint is
+    s.desired = s.measured;
+    s.following = false;
+  }
+  if (just_initialized) start_return_from_stop(j, s);
+  if (s.returning && !s.following && std::abs(s.measured - s.goal) <= kSettledCounts &&
+      std::abs(s.measured - before) <= kStillCounts) {
+    s.returning = false;
+    s.calibrating = false;
+  }
+  const double q = joint_value_of(j, s.measured);
+  if (initialized) flags |= kCalibrated;
+  if (s.calibrating) flags |= kCalibrating;
+  if (reads_ > 0 && restarted) velocity_.restart(j, q);
+  out.q = q;
+  out.flags = flags;
+  return initialized;
+}
+
+void MicroboDriver::start_return_from_stop(std::size_t j, JointState& s) noexcept {
+  // The stop lies outside the joint's range: calibration ends back inside it, at the lower
+  // limit plus the stop's margin, at the speed INITIALIZE sought the stop with.
+  const kin::Joint& m = model_.joints[j];
+  s.returning = true;
+  s.goal = counts_of(j, m.lower + config_.joints[j].hard_stop_margin);
+  s.rate = 0.1 * m.max_velocity / m.resolution_per_count;
+  s.following = true;
+}
+
+void MicroboDriver::read_motor_parameters() noexcept {
+  // The motor parameters, read back from the joint micro's RAM.
+  const auto j = static_cast<std::size_t>(examine_);
+  examine_ = -1;
+  BusError e = BusError::ok;
+  for (std::size_t i = 0; i < 16 && e == BusError::ok; i += 2) {
+    std::uint16_t word = 0;
+    e = put_word(j, rcu::kSetRamPointer, static_cast<std::uint16_t>(hw::kRcuMotorParameterRam + i));
+    if (e == BusError::ok) e = get_word(j, rcu::kReadRamWord, word);
+    examined_parameters_[i] = static_cast<std::uint8_t>(word & 0xff);
+    examined_parameters_[i + 1] = static_cast<std::uint8_t>(word >> 8);
+  }
+  examined_ = e == BusError::ok ? static_cast<std::int8_t>(j) : std::int8_t{-1};
 }
 
 void MicroboDriver::send(const JointCommands& commands) noexcept {
@@ -313,27 +320,33 @@ void MicroboDriver::follow(std::size_t j, JointState& s) noexcept {
     s.desired = s.measured;  // servo to where the joint is: it yields to a push
   }
   const double previous = s.desired;
-  if (s.following && !zero_gravity_) {
-    const double left = s.goal - s.desired;
-    if (s.rate <= 0.0) {
-      s.desired = s.goal;  // POSVEL: there at the end of this period
-    } else {
-      // POS: a trapezoid at the joint's pace: accelerate to the rate, brake to stop on the goal.
-      const hw::RcuJointConfig& c = config_.joints[j];
-      const double accel = kPaceAccelerationFraction * c.follow_acceleration *
-                           c.counts_per_ms2_per_acceleration_unit * 1e6;  // counts/s^2
-      const double braking = std::sqrt(2.0 * accel * std::abs(left));
-      const double wanted = std::copysign(std::min(s.rate, braking), left);
-      s.pace += std::clamp(wanted - s.pace, -accel * period, accel * period);
-      const double step = s.pace * period;
-      s.desired =
-          std::abs(step) >= std::abs(left) || step * left <= 0.0 ? s.goal : s.desired + step;
-    }
-    if (s.desired == s.goal) {  // then held there
-      s.following = false;
-      s.pace = 0.0;
-    }
+  if (s.following && !zero_gravity_) advance_desired(j, s, period);
+  send_target(j, s, previous, period);
+}
+
+void MicroboDriver::advance_desired(std::size_t j, JointState& s, double period) noexcept {
+  const double left = s.goal - s.desired;
+  if (s.rate <= 0.0) {
+    s.desired = s.goal;  // POSVEL: there at the end of this period
+  } else {
+    // POS: a trapezoid at the joint's pace: accelerate to the rate, brake to stop on the goal.
+    const hw::RcuJointConfig& c = config_.joints[j];
+    const double accel = kPaceAccelerationFraction * c.follow_acceleration *
+                         c.counts_per_ms2_per_acceleration_unit * 1e6;  // counts/s^2
+    const double braking = std::sqrt(2.0 * accel * std::abs(left));
+    const double wanted = std::copysign(std::min(s.rate, braking), left);
+    s.pace += std::clamp(wanted - s.pace, -accel * period, accel * period);
+    const double step = s.pace * period;
+    s.desired = std::abs(step) >= std::abs(left) || step * left <= 0.0 ? s.goal : s.desired + step;
   }
+  if (s.desired == s.goal) {  // then held there
+    s.following = false;
+    s.pace = 0.0;
+  }
+}
+
+void MicroboDriver::send_target(std::size_t j, JointState& s, double previous,
+                                double period) noexcept {
   const double lag = s.desired - s.measured;
   double target = s.desired;
   // Raw: a speed setting twice what this sample's step needs (sent exactly that, the law

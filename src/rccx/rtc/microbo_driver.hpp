@@ -119,7 +119,17 @@ class MicroboDriver final : public Driver {
   /// ... and at rest when it moved no more than this between two reads.
   static constexpr double kStillCounts = 2.0;
 
+  /// One joint's status and position into `out` (q, flags); true when it is calibrated.
+  bool read_joint(std::size_t j, JointHow& out) noexcept;
+  /// INITIALIZE found the stop: the joint goes back inside its range.
+  void start_return_from_stop(std::size_t j, JointState& s) noexcept;
+  /// The examined joint's motor parameters, from its micro's RAM.
+  void read_motor_parameters() noexcept;
   void follow(std::size_t j, JointState& s) noexcept;
+  /// The desired point one period further towards the goal (POS / POSVEL).
+  void advance_desired(std::size_t j, JointState& s, double period) noexcept;
+  /// The target and speed setting this sample, by the follow or the raw scheme.
+  void send_target(std::size_t j, JointState& s, double previous, double period) noexcept;
   /// Sends joint j's 16 motor parameters (0EH): as last set, with the integration constants
   /// zeroed while `yielding`.
   BusError send_motor_parameters(std::size_t j, bool yielding) noexcept;
