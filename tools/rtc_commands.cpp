@@ -247,20 +247,19 @@ int run_marsh(const MarshArgs& a) {
   return finish(r, report_termination(r.session->release()));
 }
 
-}  // namespace
+/// What every control program's help says of the robot it runs on.
+constexpr const char* kRobotNote =
+    " Runs on a simulated robot (rccx::hw): the Microbo (default) through its emulated RCU, "
+    "registers and bus; the PUMA 560/260 with PID joint servos; any other robot file with an "
+    "ideal servo.";
 
-void add_rtc_commands(CLI::App& app, int& exit_code) {
-  const char* robot_note =
-      " Runs on a simulated robot (rccx::hw): the Microbo (default) through its emulated RCU, "
-      "registers and bus; the PUMA 560/260 with PID joint servos; any other robot file with an "
-      "ideal servo.";
-
+void add_report_command(CLI::App& app, int& exit_code) {
   auto report = std::make_shared<ReportArgs>();
   CLI::App* report_cmd = app.add_subcommand(
       "report", std::string("Report joint positions (deg, mm) every --every seconds (thesis "
                             "report.c); with --realtime also the wake-up latency of the "
                             "communication task.") +
-                    robot_note);
+                    kRobotNote);
   add_rtc_options(*report_cmd, *report);
   report_cmd
       ->add_option("--seconds", report->seconds,
@@ -273,28 +272,34 @@ void add_rtc_commands(CLI::App& app, int& exit_code) {
   report_cmd->add_flag("--json", report->json, "Print only the latency figures, as JSON");
   report_cmd->callback(
       [report, &exit_code] { guarded(exit_code, [&] { return run_report(*report); }); });
+}
 
+void add_calib_command(CLI::App& app, int& exit_code) {
   auto calib = std::make_shared<CalibArgs>();
   CLI::App* calib_cmd = app.add_subcommand(
       "calib",
       std::string("Calibrate every joint (STOPCAL) and wait for ALL JOINTS (thesis calib.c).") +
-          robot_note);
+          kRobotNote);
   add_rtc_options(*calib_cmd, *calib);
   calib_cmd->add_option("--timeout", calib->timeout, "Give up after this long: s, or with a unit")
       ->capture_default_str();
   calib_cmd->callback(
       [calib, &exit_code] { guarded(exit_code, [&] { return run_calib(*calib); }); });
+}
 
+void add_limp_command(CLI::App& app, int& exit_code) {
   auto limp = std::make_shared<RtcArgs>();
   CLI::App* limp_cmd =
-      app.add_subcommand("limp", std::string("Turn arm power off (thesis limp.c).") + robot_note);
+      app.add_subcommand("limp", std::string("Turn arm power off (thesis limp.c).") + kRobotNote);
   add_rtc_options(*limp_cmd, *limp);
   limp_cmd->callback([limp, &exit_code] { guarded(exit_code, [&] { return run_limp(*limp); }); });
+}
 
+void add_marsh_command(CLI::App& app, int& exit_code) {
   auto marsh = std::make_shared<MarshArgs>();
   CLI::App* marsh_cmd = app.add_subcommand(
       "marsh", std::string("Zero gravity: the joints follow a push and stay (thesis marsh.c).") +
-                   robot_note);
+                   kRobotNote);
   add_rtc_options(*marsh_cmd, *marsh);
   marsh_cmd
       ->add_option("--seconds", marsh->seconds,
@@ -309,23 +314,38 @@ void add_rtc_commands(CLI::App& app, int& exit_code) {
                         "N m or N for the first half of the run; repeatable");
   marsh_cmd->callback(
       [marsh, &exit_code] { guarded(exit_code, [&] { return run_marsh(*marsh); }); });
+}
 
+void add_jointtest_command(CLI::App& app, int& exit_code) {
   auto test = std::make_shared<RtcArgs>();
   CLI::App* test_cmd = app.add_subcommand(
       "jointtest",
       std::string("Command single joints through Chg, one command per line on stdin, with the "
                   "letters of the thesis's test program (? lists them; w S waits S seconds).") +
-          robot_note);
+          kRobotNote);
   add_rtc_options(*test_cmd, *test);
   test_cmd->callback(
       [test, &exit_code] { guarded(exit_code, [&] { return run_jointtest(*test); }); });
+}
 
+void add_codes_command(CLI::App& app, int& exit_code) {
   CLI::App* codes_cmd =
       app.add_subcommand("codes", "List RTC's terminate codes and their meanings");
   codes_cmd->callback([&exit_code] {
     rtc::print_terminate_codes(stdout);
     exit_code = kOk;
   });
+}
+
+}  // namespace
+
+void add_rtc_commands(CLI::App& app, int& exit_code) {
+  add_report_command(app, exit_code);
+  add_calib_command(app, exit_code);
+  add_limp_command(app, exit_code);
+  add_marsh_command(app, exit_code);
+  add_jointtest_command(app, exit_code);
+  add_codes_command(app, exit_code);
 }
 
 }  // namespace rccx::tools

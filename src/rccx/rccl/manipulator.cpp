@@ -174,24 +174,28 @@ void Manipulator::set_configuration(std::string_view name) {
   settings_.configuration = c->index;
 }
 
+void Manipulator::check_joint_goal(const Position& p) {
+  const kin::JointVector& q = p.joint_values();
+  if (q.size() != kinematics_->dof()) {
+    throw MotionError(fmt::format("position {} has {} joint values; robot {} has {} joints",
+                                  p.name(), q.size(), kinematics_->model().name,
+                                  kinematics_->dof()));
+  }
+  const int out = kinematics_->model().first_joint_outside_limits(q, kin::kLimitTolerance);
+  if (out >= 0) {
+    const kin::Joint& j = kinematics_->model().joints[static_cast<std::size_t>(out)];
+    throw MotionError(
+        fmt::format("position {}: joint {} ({}) = {:.6g} is outside its limits "
+                    "[{:.6g}, {:.6g}]",
+                    p.name(), out + 1, j.name, q[static_cast<std::size_t>(out)], j.lower, j.upper));
+  }
+  planned_configuration();
+  queued_configuration_ = kinematics_->configuration_of(q);
+}
+
 std::int16_t Manipulator::check_reachable(const Position& p) {
   if (p.in_joints()) {
-    const kin::JointVector& q = p.joint_values();
-    if (q.size() != kinematics_->dof()) {
-      throw MotionError(fmt::format("position {} has {} joint values; robot {} has {} joints",
-                                    p.name(), q.size(), kinematics_->model().name,
-                                    kinematics_->dof()));
-    }
-    const int out = kinematics_->model().first_joint_outside_limits(q, kin::kLimitTolerance);
-    if (out >= 0) {
-      const kin::Joint& j = kinematics_->model().joints[static_cast<std::size_t>(out)];
-      throw MotionError(fmt::format(
-          "position {}: joint {} ({}) = {:.6g} is outside its limits "
-          "[{:.6g}, {:.6g}]",
-          p.name(), out + 1, j.name, q[static_cast<std::size_t>(out)], j.lower, j.upper));
-    }
-    planned_configuration();
-    queued_configuration_ = kinematics_->configuration_of(q);
+    check_joint_goal(p);
     return -1;
   }
   const auto names = kinematics_->configuration_names();
@@ -237,6 +241,11 @@ std::int16_t Manipulator::check_reachable(const Position& p) {
       return static_cast<std::int16_t>(n.configuration.index);
     }
   }
+  throw_unreachable(p, t6, when, c, asked, r.status);
+}
+
+void Manipulator::throw_unreachable(const Position& p, const math::Transform& t6, const char* when,
+                                    kin::Configuration c, bool asked, kin::IkStatus status) {
   const kin::IkSolutions all = kinematics_->inverse_all(t6);
   std::string others;
   std::string first;
@@ -256,7 +265,7 @@ std::int16_t Manipulator::check_reachable(const Position& p) {
       "set_configuration(\"{}\") then move in joint mode",
       p.name(), when, cname, asked ? "the one asked for" : "the arm's",
       settings_.mode == Mode::cartesian ? "a Cartesian line keeps it" : "a joint move keeps it",
-      kin::describe(r.status), others, first));
+      kin::describe(status), others, first));
 }
 
 kin::Configuration Manipulator::planned_configuration() {

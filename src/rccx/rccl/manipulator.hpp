@@ -211,6 +211,13 @@ class Manipulator {
   /// Refuses (MotionError) a goal the motion cannot reach. Returns the configuration a joint
   /// move with none asked must take (the present one cannot reach the goal), else -1.
   std::int16_t check_reachable(const Position& p);
+  /// check_reachable for a goal in joints: their number and limits.
+  void check_joint_goal(const Position& p);
+  /// The MotionError for a goal `t6` no solution in configuration `c` reaches (`status`: why),
+  /// naming the configurations that do reach it. `when`: how the goal was evaluated.
+  [[noreturn]] void throw_unreachable(const Position& p, const math::Transform& t6,
+                                      const char* when, kin::Configuration c, bool asked,
+                                      kin::IkStatus status);
   /// The configuration the arm will be in once the queued motions have run.
   kin::Configuration planned_configuration();
 
