@@ -130,14 +130,6 @@ constexpr const char* kTestMenu =
     "  X       examine the joint's motor parameters\n"
     "  ?       this menu\n";
 
-/// Ctrl-C and SIGTERM end the console cleanly for its whole run, in control or not.
-struct StopHandlers {
-  StopHandlers() noexcept { io::install_stop_handlers(); }
-  ~StopHandlers() { io::restore_stop_handlers(); }
-  StopHandlers(const StopHandlers&) = delete;
-  StopHandlers& operator=(const StopHandlers&) = delete;
-};
-
 class Console {
  public:
   explicit Console(const RtcArgs& a);
@@ -184,7 +176,7 @@ class Console {
 
   /// main() installed the handlers at start: a signal during the start-up counts too.
   static constexpr std::uint32_t kStops = 0;
-  const StopHandlers handlers_;
+  const io::ScopedStopHandlers handlers_;
   SimulatedRobot r_;
   const kin::RobotModel& m_;
   std::shared_ptr<ControlSide> control_ = std::make_shared<ControlSide>();

@@ -23,18 +23,9 @@ struct TeachArgs {
   std::string db;
 };
 
-/// Installs the stop handlers for the whole run: Ctrl-C while no control runs must end the
-/// console cleanly too, not kill it.
-struct StopHandlers {
-  StopHandlers() noexcept { io::install_stop_handlers(); }
-  ~StopHandlers() { io::restore_stop_handlers(); }
-  StopHandlers(const StopHandlers&) = delete;
-  StopHandlers& operator=(const StopHandlers&) = delete;
-};
-
 int run_teach(const TeachArgs& a) {
   const std::string file = database_file(a.db);
-  const StopHandlers handlers;
+  const io::ScopedStopHandlers handlers;
   // The robot first: a bad --robot or --robot-file must not create the database (exit 2 changes
   // nothing).
   kin::RobotModel model = a.robot.model();

@@ -24,6 +24,15 @@ void install_stop_handlers() noexcept;
 /// Undoes one install_stop_handlers(); the last one restores the earlier dispositions.
 void restore_stop_handlers() noexcept;
 
+/// The stop handlers installed for a scope (a console's whole run: Ctrl-C while no control
+/// runs must end it cleanly too, not kill it).
+struct ScopedStopHandlers {
+  ScopedStopHandlers() noexcept { install_stop_handlers(); }
+  ~ScopedStopHandlers() { restore_stop_handlers(); }
+  ScopedStopHandlers(const ScopedStopHandlers&) = delete;
+  ScopedStopHandlers& operator=(const ScopedStopHandlers&) = delete;
+};
+
 /// How many SIGINT / SIGTERM have arrived while the handler was installed.
 std::uint32_t stop_count() noexcept;
 /// The number of the last such signal (SIGINT or SIGTERM), 0 before the first.
