@@ -97,15 +97,16 @@ class TrajectoryGenerator {
   using Phase = trajectory::Phase;
   using Text = trajectory::Text;
 
-  // The steps of a sample, in the order step() runs them.
-  void handle_stops(const SampleContext& ctx) noexcept;
-  void schedule(const SampleContext& ctx);
+  // The steps of a sample, in the order step() runs them. Inline (defined in generator.cpp, the
+  // only place that calls them): one sample costs what it cost as one function.
+  inline void handle_stops(const SampleContext& ctx) noexcept;
+  inline void schedule(const SampleContext& ctx);
   void start_or_cancel(const SampleContext& ctx);
-  void join_or_end(const SampleContext& ctx);
+  inline void join_or_end(const SampleContext& ctx);
   /// The phase's setpoint at ctx.t_s; false when it is the halt's (nothing to guard).
-  bool evaluate(const SampleContext& ctx, kin::JointVector& q);
-  bool value(const SampleContext& ctx, double t, kin::JointVector& q, kin::IkStatus& why);
-  void guard(const SampleContext& ctx, kin::JointVector& q) noexcept;
+  inline bool evaluate(const SampleContext& ctx, kin::JointVector& q);
+  inline bool value(const SampleContext& ctx, double t, kin::JointVector& q, kin::IkStatus& why);
+  inline void guard(const SampleContext& ctx, kin::JointVector& q) noexcept;
   void record(const SampleContext& ctx, const kin::JointVector& q,
               const kin::JointVector* measured) noexcept;
 

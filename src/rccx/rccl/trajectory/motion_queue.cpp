@@ -41,19 +41,6 @@ SegmentReport MotionQueue::report(std::uint64_t id) const noexcept {
   return r.id == id ? r : SegmentReport{};
 }
 
-void MotionQueue::take() noexcept {
-  if (waiting_) return;
-  MotionRequest r;
-  if (requeued_) {
-    waiting_ = requeued_;
-    requeued_.reset();
-    rendezvous_ready_ = false;
-  } else if (requests_.pop(r)) {
-    waiting_ = r;
-    rendezvous_ready_ = false;
-  }
-}
-
 GateState MotionQueue::gate_state(Text& why) const noexcept {
   const MotionRequest& r = *waiting_;
   for (std::size_t k = 0; k < r.gates; ++k) {

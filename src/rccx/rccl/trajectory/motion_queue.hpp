@@ -50,7 +50,18 @@ class MotionQueue {
   /// No request waiting, none put back.
   [[nodiscard]] bool idle() const noexcept { return !waiting_ && !requeued_; }
   /// When none waits: the request put back, else the next one queued.
-  void take() noexcept;
+  void take() noexcept {
+    if (waiting_) return;
+    MotionRequest r;
+    if (requeued_) {
+      waiting_ = requeued_;
+      requeued_.reset();
+      rendezvous_ready_ = false;
+    } else if (requests_.pop(r)) {
+      waiting_ = r;
+      rendezvous_ready_ = false;
+    }
+  }
   /// Whether the waiting request's gates let it start now (its rendezvous apart); cancel: why
   /// says why.
   GateState gate_state(Text& why) const noexcept;
