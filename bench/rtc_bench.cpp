@@ -11,9 +11,9 @@
 #include <thread>
 
 #include "rccx/hw/simulated_arm.hpp"
+#include "rccx/rtc/doorbell.hpp"
 #include "rccx/rtc/servo_driver.hpp"
 #include "rccx/rtc/session.hpp"
-#include "rccx/rtc/doorbell.hpp"
 
 namespace {
 
