@@ -8,8 +8,13 @@
 //   3. a cell of two robots (cells/cvarl.json): a selector chooses whose plots are shown; each
 //      robot's plots hold its own samples (the last point plotted is the server's sample of that
 //      robot at that time), the second's as well as the first's; the goals of both robots'
-//      moves are drawn without the program showing them, the running ones marked.
-// Screenshots go to ARTIFACT_DIR (view-live.png, view-replay.png, view-cell.png).
+//      moves are drawn without the program showing them, the running ones marked; the page
+//      loaded afresh five times (the socket, the scene and the 3D set-up race at each load) ends
+//      "live" with both robots' uPlot plots holding points, each time;
+//   4. layout: at 1280 x 760 and at 800 x 600 the live, replay and cell pages fit the window (no
+//      scrollbar) with the 3D canvas inside the viewport.
+// Screenshots go to ARTIFACT_DIR (view-live.png, view-replay.png, view-cell.png, and the
+// live and cell pages at 800 x 600: view-live-800x600.png, view-cell-800x600.png).
 //
 //   node view_e2e.mjs RCCX ARTIFACT_DIR NODE_MODULES
 // Exit 0 pass, 1 fail, 77 skipped (no chromium or no node_modules: said why).
@@ -64,8 +69,9 @@ const stop = (p) => new Promise((resolve) => {
 });
 const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
 
-async function openPage(browser, url, errors) {
-  const page = await browser.newPage({ viewport: { width: 1280, height: 760 } });
+const defaultSize = { width: 1280, height: 760 };
+async function openPage(browser, url, errors, viewport = defaultSize) {
+  const page = await browser.newPage({ viewport });
   page.on('console', (m) => { if (m.type() === 'error') errors.push(`console: ${m.text()}`); });
   page.on('pageerror', (e) => errors.push(`page: ${e.message}`));
   await page.goto(url);
@@ -75,6 +81,52 @@ async function openPage(browser, url, errors) {
     const state = await page.evaluate(() => JSON.stringify(window.rccxView)).catch(() => '?');
     throw new Error(`${url} not ready in 45 s: ${state}; ${errors.join('; ')}`);
   }
+  return page;
+}
+
+/// The page fits its window: no horizontal (nor vertical) scrollbar, the 3D canvas whole and
+/// inside the viewport, the plots' pane inside it too.
+async function checkLayout(page, what) {
+  const l = await page.evaluate(() => {
+    const box = (sel) => {
+      const r = document.querySelector(sel).getBoundingClientRect();
+      return { left: r.left, top: r.top, right: r.right, bottom: r.bottom, width: r.width, height: r.height };
+    };
+    const se = document.scrollingElement;
+    return { w: innerWidth, h: innerHeight, sw: se.scrollWidth, sh: se.scrollHeight,
+      canvas: box('#scene canvas'), plots: box('#plots') };
+  });
+  const inside = (b) => b.left >= 0 && b.top >= 0 && b.right <= l.w + 0.5 && b.bottom <= l.h + 0.5;
+  check(l.sw <= l.w && l.sh <= l.h,
+    `${what}: the page fits ${l.w} x ${l.h} without scrollbars (scroll size ${l.sw} x ${l.sh})`);
+  check(inside(l.canvas) && l.canvas.width >= 200 && l.canvas.height >= 150 && inside(l.plots),
+    `${what}: the 3D canvas (${l.canvas.width} x ${l.canvas.height} at ${l.canvas.left}, ` +
+    `${l.canvas.top}) and the plots are inside the viewport`);
+}
+
+/// A fresh page of the cell: its status leaves "loading" / "connecting" for "live" and each
+/// robot's uPlot plots, chosen in turn with the selector, hold points; the layout fits.
+async function checkCellPage(browser, url, names, viewport, what) {
+  const errors = [];
+  const page = await openPage(browser, url, errors, viewport);
+  const live = await page.waitForFunction(() => document.getElementById('status').textContent === 'live',
+    null, { timeout: 30000 }).then(() => true, () => false);
+  const statusText = await page.textContent('#status');
+  const drawn = [];
+  for (const name of names) {
+    await page.selectOption('#plot-robot', { label: name });
+    const ok = await page.waitForFunction((n) => {
+      const s = window.rccxView.plotSeries(n);
+      return window.rccxView.plotted === n && s && s.joints > 0 && s.cart > 0 && s.vel > 0;
+    }, name, { timeout: 30000 }).then(() => true, () => false);
+    const s = await page.evaluate((n) => window.rccxView.plotSeries(n), name);
+    drawn.push(`${name} ${ok ? `${s.joints} / ${s.cart} / ${s.vel}` : `EMPTY ${JSON.stringify(s)}`}`);
+    if (!ok) break;
+  }
+  const allDrawn = drawn.length === names.length && drawn.every((d) => !d.includes('EMPTY'));
+  check(live && allDrawn, `${what}: status "${statusText}", each robot's plots hold points (${drawn.join(', ')})`);
+  await checkLayout(page, what);
+  check(errors.length === 0, `${what}: no console error (${errors.join('; ') || 'none'})`);
   return page;
 }
 
@@ -145,7 +197,12 @@ try {
   const api = await fetch(`${live.url}api/scene?robot=nope`);
   check(api.status === 404 && /no robot "nope"/.test((await api.json()).error), '/api/scene?robot=nope is a 404 with a message');
 
+  await checkLayout(page, 'the live page');
   await page.screenshot({ path: join(artifacts, 'view-live.png') });
+  await page.setViewportSize({ width: 800, height: 600 });
+  await page.waitForTimeout(300);
+  await checkLayout(page, 'the live page at 800 x 600');
+  await page.screenshot({ path: join(artifacts, 'view-live-800x600.png') });
   check(errors.length === 0, `no console error (${errors.join('; ') || 'none'})`);
   await second.close();
   await page.close();
@@ -186,7 +243,12 @@ try {
   check(played > shown.t, `play moves on (${shown.t.toFixed(3)} -> ${played.toFixed(3)} s)`);
   const rpoints = await rpage.evaluate(() => window.rccxView.plotPoints);
   check(rpoints.joints === rows.length, `the replay's plots hold the run (${rpoints.joints} of ${rows.length})`);
+  await checkLayout(rpage, 'the replay');
   await rpage.screenshot({ path: join(artifacts, 'view-replay.png') });
+  await rpage.setViewportSize({ width: 800, height: 600 });
+  await rpage.waitForTimeout(300);
+  await checkLayout(rpage, 'the replay at 800 x 600');
+  check(await rpage.isVisible('#slider'), 'the replay\'s slider is visible at 800 x 600');
   check(rerrors.length === 0, `no console error in the replay (${rerrors.join('; ') || 'none'})`);
   await stop(replay.proc);
 
@@ -244,6 +306,16 @@ try {
     `each robot's running goal is marked (${marks.goals.join(', ')}; marked: ${marks.active.join(', ')})`);
   await cpage.screenshot({ path: join(artifacts, 'view-cell.png') });
   check(cerrors.length === 0, `no console error on the cell's page (${cerrors.join('; ') || 'none'})`);
+  await cpage.close();
+  // The page loaded afresh, five times, while the cell runs: the socket, the scene's request and
+  // the 3D set-up race each time; every load must end live with both robots' plots drawn.
+  for (let i = 1; i <= 5; ++i) {
+    await (await checkCellPage(browser, cell.url, names, defaultSize, `cell page, load ${i}`)).close();
+  }
+  const small = await checkCellPage(browser, cell.url, names, { width: 800, height: 600 },
+    'cell page at 800 x 600');
+  await small.screenshot({ path: join(artifacts, 'view-cell-800x600.png') });
+  await small.close();
   await stop(cell.proc);
 } catch (e) {
   console.log(`FAIL ${e.stack || e}`);

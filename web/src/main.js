@@ -6,8 +6,9 @@
 //
 // What the page draws is also in window.rccxView (for the end-to-end test): the joint values
 // and time of the pose drawn, per robot, the goal each robot's running motion goes to, the
-// frames drawn, which robot's plots are shown, how many points they hold, and plotData(name):
-// the last point of a robot's joint plot as uPlot holds it, back in rad / m.
+// frames drawn, which robot's plots are shown, how many points they hold, plotData(name):
+// the last point of a robot's joint plot as uPlot holds it, back in rad / m, and
+// plotSeries(name): how many points its uPlot plots hold.
 import * as THREE from 'three';
 import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
 import { CSS2DRenderer, CSS2DObject } from 'three/examples/jsm/renderers/CSS2DRenderer.js';
@@ -26,6 +27,7 @@ const view = {
   plots: {},           // per robot name: its points { joints, cart, vel }
   frameNames: [],      // the frames drawn, "name" (the cell's) or "robot:name" (a goal)
   plotData: () => null,
+  plotSeries: () => null,  // (name): the points in that robot's uPlot plots as drawn
 };
 window.rccxView = view;
 
@@ -34,6 +36,42 @@ const status = (text, bad = false) => {
   $('status').textContent = text;
   $('status').className = bad ? 'bad' : '';
 };
+
+// --- The live samples -----------------------------------------------------------------------
+// The socket opens at once, beside the scene's request and the 3D set-up (seconds in software
+// WebGL on a loaded machine): samples that come before the page can draw them wait in `queue`
+// and are taken, in order, when it can (link.take). The status line says where the page is:
+// loading the scene, connecting, waiting for samples, live, ended.
+const pageRobot = location.pathname.match(/^\/robot\/([^/]+)$/);
+const only = pageRobot ? decodeURIComponent(pageRobot[1]) : null;
+const link = { ws: null, opened: false, queue: [], take: null, scene: false, samples: 0, ended: false };
+function showLink() {
+  if (view.errors.length || view.mode === 'replay') return;  // their own status lines
+  if (link.ended) status(link.opened ? 'the program has ended (no more samples)'
+    : `cannot connect to ${location.host}: is rccx view still running?`, true);
+  else if (!link.scene) status(link.opened ? 'connected; loading the scene' : 'loading the scene');
+  else if (!link.opened) status('connecting');
+  else status(link.samples ? 'live' : 'connected; waiting for samples');
+}
+function openLink() {
+  const ws = new WebSocket(`ws://${location.host}/ws${only ? `?robot=${encodeURIComponent(only)}` : ''}`);
+  link.ws = ws;
+  ws.onopen = () => { link.opened = true; showLink(); };
+  ws.onclose = () => { link.ended = true; showLink(); };
+  ws.onmessage = (ev) => {
+    const msg = JSON.parse(ev.data);
+    if (msg.type === 'hello' && msg.mode === 'replay') {
+      ws.onclose = null;  // a replay has no live samples: its page reads /api/log
+      ws.close();
+      return;
+    }
+    if (msg.type !== 'frames') return;
+    if (link.take) link.take(msg.frames);
+    else link.queue.push(msg.frames);
+  };
+}
+openLink();
+showLink();
 
 // --- Kinematics: standard DH, as rccx::kin::link_frames ---------------------------------------
 function dhMatrix(j, q) {
@@ -85,6 +123,8 @@ grid.rotation.x = Math.PI / 2;
 scene.add(grid);
 scene.add(new THREE.AxesHelper(0.15));
 
+/// The canvas takes the pane's size; the pane's size comes from the layout (style.css), which
+/// may change without a window resize (the panes stacked, the replay's footer shown).
 function resize() {
   const w = container.clientWidth, h = container.clientHeight;
   renderer.setSize(w, h);
@@ -92,7 +132,8 @@ function resize() {
   camera.aspect = w / Math.max(h, 1);
   camera.updateProjectionMatrix();
 }
-window.addEventListener('resize', resize);
+new ResizeObserver(resize).observe(container);
+resize();
 
 function label(text) {
   const div = document.createElement('div');
@@ -319,7 +360,7 @@ function markGoal(r, goal) {
 }
 
 // --- Plots ------------------------------------------------------------------------------------
-const plotWidth = () => Math.max(300, $('plots').clientWidth - 12);
+const plotWidth = () => Math.max(200, $('plots').clientWidth - 12);
 const axisStyle = { stroke: '#aab', grid: { stroke: '#2c3038' }, ticks: { stroke: '#2c3038' } };
 const seriesColours = ['#e0a040', '#50a0e0', '#80d080', '#d070d0', '#e06060', '#60d0d0', '#c0c060', '#a080ff'];
 
@@ -403,6 +444,10 @@ class Plots {
   points() {
     return { joints: this.data.joints[0].length, cart: this.data.cart[0].length, vel: this.data.vel[0].length };
   }
+  /// How many points each of the three uPlot plots holds now (what is drawn, not what is kept).
+  drawn() {
+    return { joints: this.joints.data[0].length, cart: this.cart.data[0].length, vel: this.vel.data[0].length };
+  }
   /// Draws what came since the last flush; a hidden group only counts (drawn when shown).
   flush() {
     view.plots[this.name] = this.points();
@@ -444,8 +489,6 @@ function readout(robot, desc, t) {
 
 // --- Start ------------------------------------------------------------------------------------
 async function main() {
-  const m = location.pathname.match(/^\/robot\/([^/]+)$/);
-  const only = m ? decodeURIComponent(m[1]) : null;
   const res = await fetch(only ? `/api/scene?robot=${encodeURIComponent(only)}` : '/api/scene');
   const desc = await res.json();
   if (!res.ok) throw new Error(desc.error || `the scene: HTTP ${res.status}`);
@@ -501,8 +544,12 @@ async function main() {
     for (const p of plots.values()) if (p.name === name) return p.last();
     return null;
   };
-  resize();
-  window.addEventListener('resize', () => shown.resize());
+  view.plotSeries = (name) => {
+    for (const p of plots.values()) if (p.name === name) return p.drawn();
+    return null;
+  };
+  // The plots take their pane's width (the panes stack in a narrow window).
+  new ResizeObserver(() => shown.resize()).observe($('plots'));
 
   // Frames the program adds while it runs (the goals of the positions it moves to).
   const refreshFrames = async () => {
@@ -515,36 +562,48 @@ async function main() {
 
   let latest = null;
   let refreshing = false;
+  // The plots and the readout are drawn on a timer, not in the animation frame: they fill even
+  // when the 3D pane draws slowly or not at all (software WebGL, a page in the background).
+  let drawPending = null;
+  const drawPlots = () => {
+    drawPending = null;
+    for (const p of plots.values()) p.flush();
+    const d = desc.robots.find((r) => r.index === shown.robot.index);
+    readout(shown.robot, d, latest ? shown.robot.state.t : null);
+  };
+  const take = (frames) => {
+    for (const f of frames) {
+      const r = robots.get(f.r);
+      if (!r) continue;
+      // The scene graph takes the pose at once (a few matrix products); the next animation
+      // frame shows it. rccxView holds what the scene graph holds.
+      r.pose(f.q);
+      r.state.t = f.t;
+      r.state.q = f.q.slice();
+      r.state.seg = f.seg;
+      r.addPathPoint(f.p);
+      plots.get(f.r).push(f);
+      // A goal not drawn yet (moved to since the last look at the scene): look again soon.
+      if (f.goal && !frameObjects.has(frameKey(f.r, f.goal)) && !refreshing) {
+        refreshing = true;
+        refreshFrames().finally(() => { refreshing = false; });
+      }
+      markGoal(r, f.goal);
+      view.frames++;
+      latest = f;
+    }
+    if (frames.length && !link.samples++) showLink();
+    if (!drawPending) drawPending = setTimeout(drawPlots, 100);
+  };
   if (desc.mode === 'replay') {
     await replay(robots.get(first.index), first, shown);
   } else {
-    const ws = new WebSocket(`ws://${location.host}/ws${only ? `?robot=${encodeURIComponent(only)}` : ''}`);
-    ws.onopen = () => status('live');
-    ws.onclose = () => status('the program has ended (no more samples)', true);
-    ws.onmessage = (ev) => {
-      const msg = JSON.parse(ev.data);
-      if (msg.type !== 'frames') return;
-      for (const f of msg.frames) {
-        const r = robots.get(f.r);
-        if (!r) continue;
-        // The scene graph takes the pose at once (a few matrix products); the next animation
-        // frame shows it. rccxView holds what the scene graph holds.
-        r.pose(f.q);
-        r.state.t = f.t;
-        r.state.q = f.q.slice();
-        r.state.seg = f.seg;
-        r.addPathPoint(f.p);
-        plots.get(f.r).push(f);
-        // A goal not drawn yet (moved to since the last look at the scene): look again soon.
-        if (f.goal && !frameObjects.has(frameKey(f.r, f.goal)) && !refreshing) {
-          refreshing = true;
-          refreshFrames().finally(() => { refreshing = false; });
-        }
-        markGoal(r, f.goal);
-        view.frames++;
-        latest = f;
-      }
-    };
+    // What came while the scene was built, then each message as it comes.
+    for (const frames of link.queue.splice(0)) take(frames);
+    link.take = take;
+    link.scene = true;
+    showLink();
+    drawPlots();
   }
 
   function frame() {
@@ -556,11 +615,6 @@ async function main() {
         r.state.seg = r.pending.seg;
         r.pending = null;
       }
-    }
-    if (desc.mode !== 'replay') {
-      for (const p of plots.values()) p.flush();
-      const d = desc.robots.find((r) => r.index === shown.robot.index);
-      readout(shown.robot, d, latest ? shown.robot.state.t : null);
     }
     controls.update();
     renderer.render(scene, camera);
@@ -579,7 +633,6 @@ async function replay(robot, desc, plots) {
   for (const p of log.p) robot.addPathPoint(p);
   plots.setRun(log);
   plots.flush();
-  resize();
   plots.resize();
   const slider = $('slider');
   slider.max = String(log.t.length - 1);
