@@ -14,6 +14,7 @@
 
 #include "rccx/rtc/session.hpp"
 #include "rccx/rtc/types.hpp"
+#include "real_time_verdict.hpp"
 
 // clang-format off
 #define RCCX_RTC_GLOBALS
@@ -288,6 +289,9 @@ TEST_F(CompatRtc, RealTimeABusyLoopOnTerminateSeesControlEnd) {
   while (terminate_now() == 0 &&
          std::chrono::steady_clock::now() - start < std::chrono::seconds(10)) {
   }
+  if (terminate_now() == RTC_TERM_OVERRUN) {
+    RCCX_SKIP_UNLESS_FIFO("control overran its 28 ms period before the ramp reached the limit");
+  }
   EXPECT_EQ(terminate_now(), RTC_TERM_TARGET_POSITION);
   EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(5));
   EXPECT_EQ(rtc_release(0), RTC_E_TERMINATED);
@@ -298,9 +302,13 @@ TEST_F(CompatRtc, RealTimeRtcWaitSleepsWhileControlRuns) {
   setenv("RCCX_CLOCK", "real", 1);
   ASSERT_EQ(control(fn(ramp_fn1), nullptr), RTC_OK);
   const auto start = std::chrono::steady_clock::now();
-  EXPECT_EQ(rtc_wait(300.), RTC_OK);
+  const long wait_code = rtc_wait(300.);
   const double waited =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (terminate_now() == RTC_TERM_OVERRUN) {
+    RCCX_SKIP_UNLESS_FIFO("control overran its 28 ms period during the wait");
+  }
+  EXPECT_EQ(wait_code, RTC_OK);
   EXPECT_GE(waited, 0.29);
   EXPECT_EQ(release(nullptr), RTC_OK);
   EXPECT_GE(fn1_samples, 5);  // 28 ms samples: about 10 in 0.3 s, fewer on a loaded machine
@@ -313,7 +321,11 @@ TEST_F(CompatRtc, RealTimeTerminateSetInFn2IsKeptAndSeenAfterTheWait) {
   ramp_step = 0.001;
   stop_after = 10;
   ASSERT_EQ(control(fn(ramp_fn1), fn(ramp_fn2)), RTC_OK);
-  EXPECT_EQ(rtc_wait_terminated(5000.), RTC_TERM_USER_REQUEST);
+  const long ended = rtc_wait_terminated(5000.);
+  if (ended == RTC_TERM_OVERRUN) {
+    RCCX_SKIP_UNLESS_FIFO("control overran its 28 ms period before fn2 set terminate");
+  }
+  EXPECT_EQ(ended, RTC_TERM_USER_REQUEST);
   EXPECT_EQ(terminate, 1);
   EXPECT_EQ(ramp_samples, 10);
   EXPECT_EQ(release(nullptr), RTC_OK);

@@ -20,6 +20,7 @@
 #include "rccx/kinematics/kinematics.hpp"
 #include "rccx/rtc/servo_driver.hpp"
 #include "rccx/rtc/session.hpp"
+#include "real_time_verdict.hpp"
 
 using namespace rccx;
 using namespace std::chrono_literals;
@@ -523,18 +524,28 @@ TEST(RtcWatchdog, AnF2ThatOverrunsEndsTheSessionWithOverrun) {
 TEST(RtcWatchdog, AMissedKickInRealTimeEndsTheSessionWithOverrun) {
   rtc::SessionOptions o;
   o.clock = rtc::ClockKind::real_time;
-  o.real_time_scheduling = false;  // a test must not take a core from the others
-  o.period = 20ms;  // long enough that a loaded test machine does not overrun by itself
-  Rig r("stanford", o);
-  std::atomic<bool> stall{false};
-  r.session.control({}, [&](rtc::Control&) {
-    if (stall.exchange(false)) std::this_thread::sleep_for(100ms);  // never kicks in time
-  });
-  std::this_thread::sleep_for(60ms);
-  ASSERT_FALSE(r.session.termination().ended()) << "ended before the stall";
-  stall = true;
-  const rtc::Termination t = r.session.wait_terminated(2s);
-  EXPECT_EQ(t.code, TerminateCode::overrun);
+  // SCHED_FIFO when permitted (the session sleeps most of each period: it takes no core from
+  // the other tests); without it a loaded machine may overrun a period by itself: tried again.
+  o.real_time_scheduling = rccx::test::may_use_fifo();
+  o.period = 20ms;
+  for (int attempt = 1; attempt <= 3; ++attempt) {
+    Rig r("stanford", o);
+    std::atomic<bool> stall{false};
+    r.session.control({}, [&](rtc::Control&) {
+      if (stall.exchange(false)) std::this_thread::sleep_for(100ms);  // never kicks in time
+    });
+    std::this_thread::sleep_for(60ms);
+    if (r.session.termination().ended()) {
+      ASSERT_FALSE(o.real_time_scheduling)
+          << "ended before the stall, under SCHED_FIFO: " << r.session.termination().detail_view();
+      continue;
+    }
+    stall = true;
+    const rtc::Termination t = r.session.wait_terminated(2s);
+    EXPECT_EQ(t.code, TerminateCode::overrun);
+    return;
+  }
+  RCCX_SKIP_UNLESS_FIFO("3 sessions of 20 ms overran by themselves before the stall");
 }
 
 TEST(RtcSession, TerminateFromF2WithAMessageEndsWithinTwoPeriods) {
