@@ -50,6 +50,11 @@ cmake_project() {
   mkdir -p "$dir"
   sources "$dir"
   block "$name" > "$dir/CMakeLists.txt"
+  # Beside the README's lines: the package says where its data is (CMake's ${}, not the shell's).
+  # shellcheck disable=SC2016
+  echo 'if(NOT EXISTS "${rccx_DATA_DIR}/cells/cvarl.json")
+  message(FATAL_ERROR "rccx_DATA_DIR (${rccx_DATA_DIR}) has no cells/cvarl.json")
+endif()' >> "$dir/CMakeLists.txt"
   cmake -S "$dir" -B "$dir/build" -DCMAKE_PREFIX_PATH="$prefix" -DCMAKE_BUILD_TYPE=Debug \
     -DCMAKE_C_FLAGS="$flags" -DCMAKE_CXX_FLAGS="$flags" -DCMAKE_EXE_LINKER_FLAGS="$flags" \
     > "$dir/configure.log" 2>&1 || { cat "$dir/configure.log"; exit 1; }
