@@ -546,7 +546,8 @@ typedef struct rccl_manip MANIP;
 
 /**
  * Opens the cell described by `cell_file` (NULL: the environment variable RCCX_CELL, else the
- * shipped cells/cvarl.json), its robots simulated in simulated time. Returns 0, or an error
+ * shipped cells/cvarl.json: under $RCCX_DATA_DIR, the source tree, the installed share/rccx),
+ * its robots simulated in simulated time. Returns 0, or an error
  * code (RTC_E_SEQUENCE: a session or cell is open; RTC_E_ROBOT: a bad cell file, the message
  * says where).
  */

@@ -6,13 +6,13 @@
 #include <cstdarg>
 #include <cstdio>
 #include <cstdlib>
-#include <filesystem>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "compat_internal.hpp"
 #include "compat_shared.hpp"
+#include "rccx/io/data_files.hpp"
 
 namespace rccx::compat {
 
@@ -132,15 +132,14 @@ int rccl_cell_open(const char* cell_file) {
     if (path.empty()) {
       if (const char* env = std::getenv("RCCX_CELL"); env != nullptr) path = env;
     }
-    if (path.empty()) {
-      // The source tree's (a build), else the installed copy.
-      std::error_code ec;
-      path =
-          std::filesystem::exists(RCCX_DEFAULT_CELL, ec) ? RCCX_DEFAULT_CELL : RCCX_INSTALLED_CELL;
-    }
     std::unique_ptr<rccx::cell::Cell> loaded;
     try {
+      // $RCCX_DATA_DIR, the source tree, the installed copy (rccx/io/data_files.hpp).
+      if (path.empty()) path = rccx::io::find_data_file("cells/cvarl.json").string();
       loaded = rccx::cell::Cell::load(path);
+    } catch (const rccx::io::DataFileError& e) {
+      return fail(RTC_E_ROBOT, fmt::format("rccl_cell_open: {}; or set RCCX_CELL", e.what()),
+                  Say::quiet);
     } catch (const rccx::cell::CellFileError& e) {
       return fail(RTC_E_ROBOT, fmt::format("rccl_cell_open: {}", e.what()), Say::quiet);
     }

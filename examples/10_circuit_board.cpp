@@ -49,6 +49,7 @@
 #include <vector>
 
 #include "rccx/cell/cell.hpp"
+#include "rccx/io/data_files.hpp"
 #include "rccx/math/units.hpp"
 
 using namespace rccx;
@@ -112,15 +113,16 @@ int main(int argc, char** argv) {
       "the board moves (thesis 4.5, figure 4.8; CVaRL cell, simulated time)."};
   double moving_speed_mm_s = 5.0;
   std::string csv_path;
-  std::string cell_path = RCCX_CVARL_CELL;
+  std::string cell_path;  // empty: the shipped cells/cvarl.json (io::find_data_file)
   app.add_option("--moving-speed", moving_speed_mm_s,
                  "speed of the board's slow move while the Microbo probes, mm/s")
       ->check(CLI::Range(1.0, 20.0))
       ->capture_default_str();
   app.add_option("--csv", csv_path, "also write the table to this CSV file (mm, s)");
-  app.add_option("--cell", cell_path, "the cell file (the CVaRL cell's layout)")
-      ->check(CLI::ExistingFile)
-      ->capture_default_str();
+  app.add_option("--cell", cell_path,
+                 "the cell file (default: cells/cvarl.json under $RCCX_DATA_DIR, else the "
+                 "installed share/rccx or the source tree)")
+      ->check(CLI::ExistingFile);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -128,6 +130,12 @@ int main(int argc, char** argv) {
     return app.exit(e) == 0 ? 0 : 2;
   }
 
+  try {
+    if (cell_path.empty()) cell_path = io::find_data_file("cells/cvarl.json").string();
+  } catch (const io::DataFileError& e) {
+    std::fprintf(stderr, "10_circuit_board: %s, or give --cell FILE\n", e.what());
+    return 2;
+  }
   // The default options: collision checks on, each robot on its own plant (not ideal_servo).
   const std::unique_ptr<cell::Cell> loaded = cell::Cell::load(cell_path);
   cell::Cell& c = *loaded;

@@ -10,6 +10,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "rccx/io/data_files.hpp"
 #include "rccx/io/file.hpp"
 #include "rccx/io/input.hpp"
 #include "rccx/io/parse.hpp"
@@ -225,6 +226,61 @@ TEST(WriteAll, ReportsTheFailureOfAFullDevice) {
   if (fd < 0) GTEST_SKIP() << "no /dev/full";
   EXPECT_EQ(write_all(fd, "x", 1), ENOSPC);
   ::close(fd);
+}
+
+// The shipped data: $RCCX_DATA_DIR alone when set, else the installed directory a program was
+// compiled against, then the source tree; a file in none is an error naming where it looked.
+class DataFiles : public ::testing::Test {
+ protected:
+  void SetUp() override { ::unsetenv("RCCX_DATA_DIR"); }
+  void TearDown() override { ::unsetenv("RCCX_DATA_DIR"); }
+};
+
+TEST_F(DataFiles, TheSourceTreeHasTheCellsAndRobots) {
+  for (const char* file : {"cells/cvarl.json", "robots/puma560.json"}) {
+    EXPECT_TRUE(std::filesystem::is_regular_file(find_data_file(file))) << file;
+  }
+  EXPECT_EQ(data_dirs().front(), RCCX_TEST_SOURCE_DIR);  // no installed copy in the tree
+}
+
+TEST_F(DataFiles, TheInstalledDirectoryComesFirst) {
+  const std::filesystem::path installed = testing::TempDir() + "rccx_data_installed";
+  std::filesystem::create_directories(installed / "cells");
+  std::ofstream(installed / "cells" / "cvarl.json") << "{}";
+  EXPECT_EQ(find_data_file("cells/cvarl.json", installed.string()),
+            installed / "cells" / "cvarl.json");
+  // What it lacks is found further on.
+  EXPECT_EQ(find_data_file("robots/puma560.json", installed.string()),
+            std::filesystem::path(RCCX_TEST_SOURCE_DIR) / "robots" / "puma560.json");
+  std::filesystem::remove_all(installed);
+}
+
+TEST_F(DataFiles, AnEnvironmentDirectoryIsTheOnlyPlace) {
+  const std::string none = testing::TempDir() + "rccx_data_none";
+  ::setenv("RCCX_DATA_DIR", none.c_str(), 1);
+  ASSERT_EQ(data_dirs("/somewhere").size(), 1u);
+  try {
+    find_data_file("cells/cvarl.json");
+    FAIL() << "found cells/cvarl.json in " << none;
+  } catch (const DataFileError& e) {
+    EXPECT_NE(std::string(e.what()).find(none), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("RCCX_DATA_DIR names"), std::string::npos) << e.what();
+  }
+  ::setenv("RCCX_DATA_DIR", "", 1);  // set empty: as if unset
+  EXPECT_EQ(data_dirs().front(), RCCX_TEST_SOURCE_DIR);
+}
+
+TEST_F(DataFiles, AFileNowhereNamesEveryPlaceLookedIn) {
+  try {
+    find_data_file("cells/no_such_cell.json", "/nonexistent/share/rccx");
+    FAIL() << "found cells/no_such_cell.json";
+  } catch (const DataFileError& e) {
+    const std::string what = e.what();
+    for (const char* place :
+         {"/nonexistent/share/rccx", RCCX_TEST_SOURCE_DIR, "set RCCX_DATA_DIR"}) {
+      EXPECT_NE(what.find(place), std::string::npos) << place << " not in: " << what;
+    }
+  }
 }
 
 }  // namespace

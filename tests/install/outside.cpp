@@ -1,8 +1,11 @@
-// A program of another project: one motion of a simulated PUMA 560 through the installed rccx.
+// A program of another project (README.md's app.cpp, built by tests/install_test.sh with no
+// CMAKE_CXX_STANDARD): one motion of a simulated PUMA 560 through the installed rccx, the
+// tool-load compensation, and where the installed package's data is.
 #include <cmath>
 #include <cstdio>
 
 #include "rccx/force/tool_load.hpp"
+#include "rccx/io/data_files.hpp"
 #include "rccx/kinematics/robot_model.hpp"
 #include "rccx/rccl/manipulator.hpp"
 #include "rccx/rtc/simulated_robot.hpp"
@@ -25,5 +28,7 @@ int main() {
   const math::Wrench weight{{0.0, 0.0, 2.0 * 9.81}, {0.0, 0.0, 0.0}};
   const double left_N = force::external_wrench(tool, down, weight).force_N.norm();
   std::printf("outside: a hanging tool compensated to %.2g N\n", left_N);
+  // The installed cell, found from the headers' install (not the source tree's).
+  std::printf("outside: the cell is %s\n", io::find_data_file("cells/cvarl.json").c_str());
   return error_rad < 1e-3 && left_N < 1e-9 ? 0 : 1;
 }
