@@ -140,7 +140,7 @@ TEST_F(BadInput, ControlPrograms) {
       {"", "report --seconds -1", 2, "--seconds: \"-1\" is out of range", ""},
       {"", "report --seconds 0", 2, "out of range", ""},
       {"", "report --seconds 1e7", 2, "out of range", ""},
-      {"", "report --seconds ''", 2, "a duration is missing", ""},
+      {"", "report --seconds ''", 2, "--seconds: \"\" is empty", ""},
       {"", "report --seconds 2x", 2, "not a duration", ""},
       {"", "report --every 1ms", 2, "shorter than the sample period", ""},
       {"", "report --robot puma560 --period 1ms --every 0.5ms", 2, "shorter than the sample period",
@@ -176,7 +176,7 @@ TEST_F(BadInput, ControlPrograms) {
       {"", "marsh --push 3:abc", 2, "not a number", ""},
       {"", "marsh --push :", 2, "missing", ""},
       {"", "limp --seconds 3", 2, "--seconds", ""},
-      {"", "nosuch", 2, "subcommand", ""},
+      {"", "nosuch", 2, "unknown command 'nosuch'", ""},
       {"", "report --seconds 0.2 --every 0.1", 0, "theta", ""},
       {"", "calib --robot puma560 --uncalibrated --timeout 60", 0, "ALL JOINTS", ""},
       {"", "cell-load --robots 0", 2, "--robots", ""},
@@ -185,6 +185,58 @@ TEST_F(BadInput, ControlPrograms) {
       {"", "cell-load --robots 2 --robot microbo", 2, "puma560 or puma260", ""},
       {"", "cell-load --robots 2 --spacing 0.5", 2, "--spacing", ""},
       {"", "cell-load --robots 3 --seconds 0.3", 0, "cycle compute over 30", ""},
+  });
+}
+
+// Unknown words: the word, the nearest known one at that level (or the list), and the help of
+// the command it was given to.
+TEST_F(BadInput, UnknownWords) {
+  check({
+      {"", "rprt", 2, "unknown command 'rprt'; did you mean 'report'?", ""},
+      {"", "rprt", 2, "Run `rccx --help`", ""},
+      {"", "kin fx", 2, "unknown command 'fx'; did you mean 'fk'?", ""},
+      {"", "kin fx", 2, "Run `rccx kin --help`", ""},
+      {"", "kin xyzzy", 2, "the commands of `rccx kin` are fk, ik, robots", ""},
+      {"", "db lst", 2, "did you mean 'list'?", ""},
+      {"", "cell shw", 2, "did you mean 'show'?", ""},
+      {"", "completion bsh", 2, "did you mean 'bash'?", ""},
+      {"", "kin", 2, "`rccx kin` needs a command: fk, ik, robots", ""},
+      {"", "report --secnds 2", 2,
+       "unknown option '--secnds' for `rccx report`; did you mean "
+       "'--seconds'?",
+       ""},
+      {"", "report --secnds 2", 2, "Run `rccx report --help`", ""},
+      {"", "kin ik --nera 0 --T 1", 2, "did you mean '--near'?", ""},
+      {"", "db list --rbot microbo", 2, "did you mean '--robot'?", ""},
+      {"", "db list --rbot microbo", 2, "Run `rccx db list --help`", ""},
+      {"", "view --prot 0", 2, "did you mean '--port'?", ""},
+      {"", "report --zzzzzzz", 2, "unknown option '--zzzzzzz' for `rccx report`\nRun", ""},
+      {"", "limp --seconds 3", 2, "unknown option '--seconds' for `rccx limp`", ""},
+      // CLI11's own errors point at the command's help too.
+      {"", "kin ik --robot puma560", 2, "Run `rccx kin ik --help`", ""},
+  });
+}
+
+// An empty value is refused for every option of every command, before anything runs.
+TEST_F(BadInput, EmptyValues) {
+  check({
+      {"", "kin ik --robot puma560 --T 1,0,0,0.4521,0,1,0,-0.15005,0,0,1,0.4318 --near ''", 2,
+       "--near: \"\" is empty; give a value", ""},
+      {"", "kin ik --robot puma560 --T 1,0,0,0.4521,0,1,0,-0.15005,0,0,1,0.4318 --config ''", 2,
+       "--config: \"\" is empty", ""},
+      {"", "kin fk --robot '' 0", 2, "--robot: \"\" is empty", ""},
+      {"", "kin fk --robot-file= 0", 2, "--robot-file: \"\" is empty", ""},
+      {"", "db put --robot microbo P --T 1,0,0,0,0,1,0,0,0,0,1,0 --config '' --db DIR/e.db", 2,
+       "--config: \"\" is empty", "e.db"},
+      {"", "db put --robot microbo P --T 1,0,0,0,0,1,0,0,0,0,1,0 --note '' --db DIR/e.db", 2,
+       "--note: \"\" is empty", "e.db"},
+      {"", "db --db '' list", 2, "--db: \"\" is empty", ""},
+      {"", "db list --db ''", 2, "--db: \"\" is empty", ""},
+      {"", "plot DIR/empty.json -o out.svg --title ''", 2, "--title: \"\" is empty", ""},
+      {"", "view --address ''", 2, "--address: \"\" is empty", ""},
+      {"", "view --port ''", 2, "--port: \"\" is empty", ""},
+      {"", "marsh --push ''", 2, "--push: \"\" is empty", ""},
+      {"", "cell-load --robot ''", 2, "--robot: \"\" is empty", ""},
   });
 }
 

@@ -117,7 +117,7 @@ TEST(Cli, BadArgumentsExitTwoAndSayWhatToDo) {
       {"kin ik --robot puma560 --T 1,0,0,0.5,0,1,0,0,0,0,1,0 --near 0,0", "6 joints, got 2"},
       {"kin ik --robot puma560", "--T is required"},
       {"kin fk --robot-file /nonexistent.json 0", "File does not exist"},
-      {"kin", "subcommand"},
+      {"kin", "needs a command: fk, ik, robots"},
   };
   for (const auto& c : cases) {
     const CliRun run = rccx_cli(c[0]);

@@ -59,6 +59,8 @@ TEST(Parse, DurationsTakeUnitsAndRanges) {
   EXPECT_EQ(parse_duration("250us", "p", BareUnit::seconds, 0ns, 1s), 250us);
   EXPECT_EQ(parse_duration("28", "p", BareUnit::milliseconds, 0ns, 1s), 28ms);
   EXPECT_EQ(parse_duration("2", "p", BareUnit::seconds, 0ns, 10s), 2s);
+  EXPECT_EQ(parse_duration("1500ns", "p", BareUnit::seconds, 0ns, 1s), 1500ns);
+  EXPECT_EQ(parse_duration("1.5min", "p", BareUnit::seconds, 0ns, 100s), 90s);
   for (const char* bad : {"", "2m", "2 s", "inf", "1e300", "-1", "ms", "2sec", "nan s"}) {
     EXPECT_THROW(parse_duration(bad, "p", BareUnit::seconds, 0ns, 10s), ParseError) << bad;
   }

@@ -178,31 +178,29 @@ int run_show(const ShowArgs& args) {
 
 struct LoadArgs {
   std::string robots = "8";
-  std::string period = "1ms";
-  std::string seconds = "2";
+  Duration period{"1ms"};
+  Duration seconds{"2s"};
   std::string robot = "puma560";
   std::string spacing = "2.5";
   bool realtime = false;
   bool plant = false;
   bool one_thread = false;
-  std::string spin_us = "0";
+  Duration spin{"0s"};
   bool json = false;
 };
 
 int run_load(const LoadArgs& a) {
   std::size_t n = 0;
-  std::chrono::nanoseconds period{};
-  double seconds = 0, spacing = 0;
-  std::int64_t spin_us = 0;
+  const std::chrono::nanoseconds period = a.period.value;
+  const double seconds = a.seconds.seconds();
+  double spacing = 0;
+  const auto spin_us = std::chrono::duration_cast<std::chrono::microseconds>(a.spin.value).count();
   try {
     n = static_cast<std::size_t>(io::parse_integer(a.robots, "--robots", 1, 4096));
-    seconds = io::parse_seconds(a.seconds, "--seconds", 1e-3, 3600);
     spacing = io::parse_number(a.spacing, "--spacing", {1.0, 100.0, "m"});
-    spin_us = io::parse_integer(a.spin_us, "--spin-us", 0, 1000);
   } catch (const io::ParseError& e) {
     throw BadArgument{e.what()};
   }
-  period = parse_period(a.period);
   if (a.robot != "puma560" && a.robot != "puma260") {
     throw BadArgument{fmt::format("--robot: {} is not one the load drives; give puma560 or puma260",
                                   io::quoted(a.robot))};
@@ -318,10 +316,9 @@ void add_cell_command(CLI::App& app, int& exit_code) {
       "cycle) in percentiles, and in real time the wake-up latency and missed deadlines");
   load_cmd->add_option("--robots", load->robots, "How many robots (1 to 4096)")
       ->capture_default_str();
-  load_cmd->add_option("--period", load->period, "The clock's period (0.25ms to 56ms)")
-      ->capture_default_str();
-  load_cmd->add_option("--seconds", load->seconds, "How long to run: s, or with a unit")
-      ->capture_default_str();
+  add_period_option(*load_cmd, load->period, "The clock's period (0.25ms to 56ms)");
+  add_duration_option(*load_cmd, "--seconds", load->seconds, std::chrono::milliseconds(1),
+                      std::chrono::hours(1), "How long to run, up to 1 h");
   load_cmd->add_option("--robot", load->robot, "puma560 or puma260")->capture_default_str();
   load_cmd->add_option("--spacing", load->spacing, "Grid spacing, m")->capture_default_str();
   load_cmd->add_flag("--realtime", load->realtime,
@@ -331,11 +328,10 @@ void add_cell_command(CLI::App& app, int& exit_code) {
   load_cmd->add_flag("--one-thread", load->one_thread,
                      "Both tasks on one thread (no hand-overs between processors; no watchdog "
                      "for a hung control function)");
-  load_cmd
-      ->add_option("--spin-us", load->spin_us,
-                   "Real time: spin this many us before each tick instead of sleeping "
-                   "through it (0 to 1000)")
-      ->capture_default_str();
+  add_duration_option(*load_cmd, "--spin", load->spin, std::chrono::nanoseconds(0),
+                      std::chrono::milliseconds(1),
+                      "Real time: spin this long before each tick instead of sleeping through "
+                      "it (0 to 1ms, e.g. 50us)");
   load_cmd->add_flag("--json", load->json, "Print the figures as JSON (us)");
   load_cmd->callback([load, &exit_code] { guarded(exit_code, [&] { return run_load(*load); }); });
 }

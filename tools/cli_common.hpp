@@ -1,4 +1,5 @@
-// What the rccx subcommands share: exit codes, the bad-argument error, the robot options.
+// What the rccx subcommands share: exit codes, the bad-argument error, duration options, the
+// robot options.
 #pragma once
 
 #include <fmt/format.h>
@@ -9,6 +10,7 @@
 #include <memory>
 #include <string>
 
+#include "cli_tree.hpp"
 #include "rccx/io/console.hpp"
 #include "rccx/io/file.hpp"
 #include "rccx/io/parse.hpp"
@@ -37,15 +39,44 @@ inline CLI::Validator not_empty() {
       "", "NOT_EMPTY");
 }
 
-/// A sample period ("1ms", "250us", "0.028s"; a bare number is in ms) within what RTC serves.
-inline std::chrono::nanoseconds parse_period(const std::string& text,
-                                             const char* what = "--period") {
-  try {
-    return io::parse_duration(text, what, io::BareUnit::milliseconds, rtc::kMinPeriod,
-                              rtc::kMaxPeriod);
-  } catch (const io::ParseError& e) {
-    throw BadArgument{fmt::format("{} (the range RTC serves)", e.what())};
-  }
+/// A duration option's value. One rule for every command (docs/RELIABILITY.md): a number and its
+/// unit, ns, us, ms, s or min ("500ms", "2s", "1.5min"); a bare number is seconds, the SI unit.
+struct Duration {
+  std::string text;  ///< as given, or the default; "" when neither (the command decides)
+  std::chrono::nanoseconds value{};
+
+  [[nodiscard]] bool given() const { return !text.empty(); }
+  [[nodiscard]] double seconds() const { return std::chrono::duration<double>(value).count(); }
+};
+
+/// Adds `name` as a duration within [lo, hi], read when the line is parsed: a bad value is
+/// refused (exit 2) before anything runs, naming the option. `d.text` is its default.
+inline CLI::Option* add_duration_option(CLI::App& cmd, const std::string& name, Duration& d,
+                                        std::chrono::nanoseconds lo, std::chrono::nanoseconds hi,
+                                        const std::string& help) {
+  const auto read = [name, lo, hi](const std::string& text) {
+    return io::parse_duration(text, name, io::BareUnit::seconds, lo, hi);
+  };
+  if (d.given()) d.value = read(d.text);  // the default, by the same rule
+  CLI::Option* o = cmd.add_option_function<std::string>(
+      name,
+      [&d, read](const std::string& text) {
+        try {
+          d.value = read(text);
+          d.text = text;
+        } catch (const io::ParseError& e) {
+          throw CLI::ValidationError(e.what());
+        }
+      },
+      help + " (a duration: 500ms, 2s, 1.5min; a bare number is s)");
+  o->type_name("DURATION");
+  if (d.given()) o->default_str(d.text);
+  return o;
+}
+
+/// --period: a sample period within what RTC serves (0.25 to 56 ms).
+inline CLI::Option* add_period_option(CLI::App& cmd, Duration& d, const std::string& help) {
+  return add_duration_option(cmd, "--period", d, rtc::kMinPeriod, rtc::kMaxPeriod, help);
 }
 
 /// --robot / --robot-file.
@@ -76,6 +107,7 @@ inline void add_robot_options(CLI::App& cmd, RobotChoice& robot) {
                  "Shipped robot to use (see `rccx kin robots`): microbo, puma560, puma260, "
                  "stanford")
       ->capture_default_str();
+  complete_with(cmd.get_option("--robot"), kin::builtin_robot_names());
   cmd.add_option("--robot-file", robot.file,
                  "Robot description file (JSON, see robots/README.md); overrides --robot")
       ->check(CLI::ExistingFile);

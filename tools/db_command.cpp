@@ -30,7 +30,7 @@ using rccl::PositionDb;
 
 struct DbArgs {
   std::string file;
-  std::string wait = "5";  // s, for another process writing the database
+  Duration wait{"5s"};  // for another process writing the database
   std::string robot;
   std::string name;
   std::string pattern = "*";
@@ -127,8 +127,7 @@ void check_transform_name(const std::string& name) {
 }
 
 std::chrono::milliseconds busy_timeout(const DbArgs& a) {
-  return std::chrono::milliseconds(
-      static_cast<std::int64_t>(io::parse_seconds(a.wait, "--wait", 0, 3600) * 1e3));
+  return std::chrono::duration_cast<std::chrono::milliseconds>(a.wait.value);
 }
 
 /// The standard input, whole (an import from a pipe).
@@ -341,9 +340,8 @@ void add_db_command(CLI::App& app, int& exit_code) {
     return o;
   };
   not_empty(db->add_option("--db", args->file, "Database file"));
-  not_empty(
-      db->add_option("--wait", args->wait,
-                     "How long to wait for another process writing the database (s, default 5)"));
+  add_duration_option(*db, "--wait", args->wait, std::chrono::nanoseconds(0), std::chrono::hours(1),
+                      "How long to wait for another process writing the database");
   db->require_subcommand(1);
   const auto robot_name = [&](CLI::App* c) {
     not_empty(c->add_option("--robot", args->robot, "The robot the transform belongs to"))

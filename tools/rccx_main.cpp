@@ -3,58 +3,42 @@
 
 #include <CLI/CLI.hpp>
 #include <exception>
+#include <memory>
+#include <string>
 #include <system_error>
+#include <vector>
 
-#include "cell_command.hpp"
 #include "cli_common.hpp"
-#include "db_command.hpp"
-#include "kin_command.hpp"
-#include "plot_command.hpp"
+#include "cli_tree.hpp"
 #include "rccx/io/console.hpp"
 #include "rccx/io/signals.hpp"
-#include "rcu_command.hpp"
-#include "rtc_commands.hpp"
-#include "teach_command.hpp"
-#include "view_command.hpp"
 
 namespace {
 
 int run(int argc, char** argv) {
-  CLI::App app{
-      "rccx - robot programming and real-time control in the manner of RCCL/RTC (1986).\n"
-      "Units are SI (m, rad, s) unless an option says otherwise. Exit codes: 0 done, 1 failed "
-      "while running, 2 bad input, 3 pose out of reach, 130 / 143 / 129 ended by SIGINT / "
-      "SIGTERM / SIGHUP.",
-      "rccx"};
-  app.set_version_flag("--version", "rccx 0.1.0");
-  app.require_subcommand(1);
-  // One wording for every bad argument, CLI11's own included (docs/RELIABILITY.md).
-  app.failure_message([](const CLI::App* from, const CLI::Error& e) {
-    std::string path;
-    for (const CLI::App* a = from; a != nullptr; a = a->get_parent()) {
-      path = a->get_name() + (path.empty() ? "" : " ") + path;
-    }
-    return fmt::format("error: {}\nRun `{} --help` for the options.\n", e.what(), path);
-  });
   int exit_code = rccx::tools::kOk;
-  rccx::tools::add_kin_command(app, exit_code);
-  rccx::tools::add_rtc_commands(app, exit_code);
-  rccx::tools::add_rcu_command(app, exit_code);
-  rccx::tools::add_db_command(app, exit_code);
-  rccx::tools::add_teach_command(app, exit_code);
-  rccx::tools::add_cell_command(app, exit_code);
-  rccx::tools::add_view_command(app, exit_code);
-  rccx::tools::add_plot_command(app, exit_code);
+  const std::unique_ptr<CLI::App> app = rccx::tools::make_app(exit_code);
+  // The words first: an unknown one is named with the nearest known one, and a verb's option
+  // given before the verb moves after it (cli_tree.hpp).
+  const rccx::tools::Words words = rccx::tools::check_words(*app, {argv + 1, argv + argc});
+  if (!words.error.empty()) {
+    rccx::io::eprint("error: {}\n", words.error);
+    return rccx::tools::kBadArguments;
+  }
+  std::vector<std::string> reversed(words.args.rbegin(), words.args.rend());  // CLI11's order
   try {
-    app.parse(argc, argv);
+    app->parse(reversed);
   } catch (const CLI::CallForHelp& e) {
-    return app.exit(e);
+    return app->exit(e);
   } catch (const CLI::CallForAllHelp& e) {
-    return app.exit(e);
+    return app->exit(e);
   } catch (const CLI::CallForVersion& e) {
-    return app.exit(e);
+    return app->exit(e);
   } catch (const CLI::ParseError& e) {
-    app.exit(e);  // prints the message and the usage hint
+    // One wording for every bad argument, CLI11's own included (docs/RELIABILITY.md); the help
+    // to read is that of the command the words reached.
+    rccx::io::eprint("error: {}\nRun `{} --help` for the options.\n", e.what(),
+                     rccx::tools::command_path(words.deepest));
     return rccx::tools::kBadArguments;
   }
   return exit_code;

@@ -32,14 +32,22 @@ std::chrono::nanoseconds to_ns(double seconds) {
 }
 
 /// The longest a control program runs or waits: beyond it a number is a typo (11.6 days).
-constexpr double kMaxRunSeconds = 1e6;
+constexpr auto kMaxRun = std::chrono::seconds(1'000'000);
+constexpr auto kMinRun = std::chrono::microseconds(1);
 
-double seconds_of(const std::string& text, const char* what, double lo_s = 1e-6) {
-  try {
-    return io::parse_seconds(text, what, lo_s, kMaxRunSeconds);
-  } catch (const io::ParseError& e) {
-    throw BadArgument{e.what()};
-  }
+CLI::Option* add_run_option(CLI::App& cmd, const std::string& name, Duration& d,
+                            const std::string& help) {
+  return add_duration_option(cmd, name, d, kMinRun, kMaxRun, help)->capture_default_str();
+}
+
+/// Waits until the samples' time is `t_s` (from the session's start), to the nearest sample:
+/// the waits aim at absolute times, so their rounding to whole samples does not add up (30 s
+/// in 0.5 s reports is 30 s, not 60 waits each rounded down), and the last report is at the
+/// sample nearest --seconds.
+rtc::Termination wait_to(const SimulatedRobot& r, double t_s) {
+  const double left = t_s - r.session->how().time_s;
+  if (left < r.period_s() / 2) return r.session->termination();
+  return r.session->wait_for(to_ns(left + r.period_s() / 2));
 }
 
 int report_termination(const rtc::Termination& t) {
@@ -60,76 +68,97 @@ int finish(SimulatedRobot& r, int code) {
 // ---------------------------------------------------------------------------------------------
 
 struct ReportArgs : RtcArgs {
-  std::string seconds = "2";
-  std::string every = "0.5";
+  Duration seconds{"2s"};
+  Duration every{"0.5s"};
   bool json = false;
 };
 
 /// --every: at least one sample period, else time would never advance between reports.
-double every_of(const std::string& text, const SimulatedRobot& r) {
-  const double every = seconds_of(text, "--every");
-  if (every < r.period_s()) {
+double every_of(const Duration& every, const SimulatedRobot& r) {
+  if (every.seconds() < r.period_s()) {
     throw BadArgument{fmt::format(
-        "--every: \"{}\" is shorter than the sample period ({:g} ms); give at least {:g}ms", text,
-        r.period_s() * 1e3, r.period_s() * 1e3)};
+        "--every: \"{}\" is shorter than the sample period ({:g} ms); give at least {:g}ms",
+        every.text, r.period_s() * 1e3, r.period_s() * 1e3)};
   }
-  return every;
+  return every.seconds();
+}
+
+/// The times of the reports: every `every` seconds, and the end of the run, which is `seconds`
+/// however long `every` is.
+std::vector<double> report_times(double seconds, double every) {
+  std::vector<double> times;
+  for (double k = 1; k * every < seconds - 1e-9; ++k) times.push_back(k * every);
+  times.push_back(seconds);
+  return times;
+}
+
+/// A real-time report measures on after control ends with an overrun (the machine missed a
+/// deadline): it says so and restarts control; the run then fails (exit 1) at the end.
+bool restart_after_overrun(SimulatedRobot& r, rtc::Termination& t, std::uint64_t& restarts) {
+  if (r.simulated() || t.code != rtc::TerminateCode::overrun) return false;
+  ++restarts;
+  io::eprint("report: control ended at t = {:.3f} s: {} ({}); restarting control (restart {})\n",
+             t.time_s, rtc::to_string(t.code), t.detail.data(), restarts);
+  r.session->release();
+  r.session->control({}, {});
+  t = {};
+  return true;
+}
+
+void print_latency(const ReportArgs& a, const SimulatedRobot& r, std::uint64_t restarts) {
+  const rtc::LatencyStats s = r.session->latency();
+  if (a.json) {
+    nlohmann::ordered_json j{{"period_us", Seconds(r.session->period()).count() * 1e6},
+                             {"seconds", a.seconds.seconds()},
+                             {"wakeups", s.wakeups},
+                             {"missed_deadlines", s.missed_deadlines},
+                             {"p50_us", s.p50_us},
+                             {"p99_us", s.p99_us},
+                             {"p999_us", s.p999_us},
+                             {"max_us", s.max_us},
+                             {"overruns", restarts}};
+    fmt::print("{}\n", j.dump(2));
+    return;
+  }
+  fmt::print(
+      "wake-up latency over {} ticks at {:.3f} ms: p50 {:.0f} us, p99 {:.0f} us, p99.9 "
+      "{:.0f} us, max {:.0f} us; missed deadlines {}; control overruns {}\n",
+      s.wakeups, r.period_s() * 1e3, s.p50_us, s.p99_us, s.p999_us, s.max_us, s.missed_deadlines,
+      restarts);
 }
 
 int run_report(const ReportArgs& a) {
-  const double seconds = seconds_of(a.seconds, "--seconds");
-  seconds_of(a.every, "--every");  // its form, before the robot is made
+  if (a.json && !a.realtime) {
+    throw BadArgument{
+        "--json prints the wake-up latency figures, which only a real-time run has; add "
+        "--realtime (simulated time prints the joint positions as text)"};
+  }
   SimulatedRobot r(a);
   const double every = every_of(a.every, r);
   r.session->control({}, {});  // empty f1 and f2: the full cycle, nothing commanded
-  const std::int64_t lines = std::max<std::int64_t>(1, std::llround(seconds / every));
-  // In real time an overrun says the machine missed a deadline: count it and go on measuring.
-  std::uint64_t overruns = 0;
+  std::uint64_t restarts = 0;
   rtc::Termination t;
-  for (std::int64_t i = 0; i < lines && !t.ended() && io::stop_count() == 0; ++i) {
-    t = r.session->wait_for(to_ns(every));
+  for (const double at : report_times(a.seconds.seconds(), every)) {
+    if (t.ended() || io::stop_count() != 0) break;
+    t = wait_to(r, at);
     if (!a.json) print_positions(r.model, r.session->how());
-    if (a.realtime && t.code == rtc::TerminateCode::overrun) {
-      ++overruns;
-      if (!a.json) rtc::print_terminate_code(t, stdout);
-      r.session->release();
-      r.session->control({}, {});
-      t = {};
-    }
+    restart_after_overrun(r, t, restarts);
   }
   if (!t.ended()) t = r.session->release();
-  if (a.realtime) {  // the figures up to the end, even when control ended early
-    const rtc::LatencyStats s = r.session->latency();
-    if (a.json) {
-      nlohmann::ordered_json j{{"period_us", Seconds(r.session->period()).count() * 1e6},
-                               {"seconds", seconds},
-                               {"wakeups", s.wakeups},
-                               {"missed_deadlines", s.missed_deadlines},
-                               {"p50_us", s.p50_us},
-                               {"p99_us", s.p99_us},
-                               {"p999_us", s.p999_us},
-                               {"max_us", s.max_us},
-                               {"overruns", overruns}};
-      fmt::print("{}\n", j.dump(2));
-    } else {
-      fmt::print(
-          "wake-up latency over {} ticks at {:.3f} ms: p50 {:.0f} us, p99 {:.0f} us, p99.9 "
-          "{:.0f} us, max {:.0f} us; missed deadlines {}; control overruns {}\n",
-          s.wakeups, r.period_s() * 1e3, s.p50_us, s.p99_us, s.p999_us, s.max_us,
-          s.missed_deadlines, overruns);
-    }
-  }
-  return finish(r, report_termination(t));
+  if (a.realtime) print_latency(a, r, restarts);  // up to the end, even when control ended early
+  const int code = report_termination(t);
+  if (restarts > 0) io::eprint("report: control was restarted {} times after overruns\n", restarts);
+  return finish(r, restarts > 0 ? kFailure : code);
 }
 
 // ---------------------------------------------------------------------------------------------
 
 struct CalibArgs : RtcArgs {
-  std::string timeout = "120";
+  Duration timeout{"120s"};
 };
 
 int run_calib(const CalibArgs& a) {
-  const double timeout = seconds_of(a.timeout, "--timeout");
+  const double timeout = a.timeout.seconds();
   SimulatedRobot r(a);
   const rtc::How before = r.session->how();
   fmt::print("calibrating the {} joints of {} ({}): each seeks its calibration position\n",
@@ -152,7 +181,7 @@ int run_calib(const CalibArgs& a) {
         }
         return h.all_calibrated;
       },
-      to_ns(timeout));
+      a.timeout.value);
   const rtc::How h = r.session->how();
   const rtc::Termination t = r.session->release();
   if (t.ended()) return finish(r, report_termination(t));
@@ -186,8 +215,8 @@ int run_limp(const RtcArgs& a) {
 // ---------------------------------------------------------------------------------------------
 
 struct MarshArgs : RtcArgs {
-  std::string seconds = "4";
-  std::string every = "0.5";
+  Duration seconds{"4s"};
+  Duration every{"0.5s"};
   std::vector<std::string> pushes;
 };
 
@@ -196,8 +225,6 @@ int run_marsh(const MarshArgs& a) {
     std::size_t joint;
     double effort;
   };
-  const double seconds = seconds_of(a.seconds, "--seconds");
-  seconds_of(a.every, "--every");
   SimulatedRobot r(a);
   const double every = every_of(a.every, r);
   std::vector<Push> pushes;
@@ -232,12 +259,13 @@ int run_marsh(const MarshArgs& a) {
       {});
   fmt::print("zero gravity: the joints follow a push and stay where they are left{}\n",
              pushes.empty() ? "" : " (pushing for the first half)");
-  const std::int64_t lines = std::max<std::int64_t>(1, std::llround(seconds / every));
-  for (std::int64_t i = 0; i < lines && io::stop_count() == 0; ++i) {
+  const double seconds = a.seconds.seconds();
+  for (const double at : report_times(seconds, every)) {
+    if (io::stop_count() != 0) break;
     // Between samples of simulated time the arm is the planning level's to touch.
-    const bool pushing = 2 * i < lines;
+    const bool pushing = at - every < seconds / 2;
     for (const Push& p : pushes) r.push(p.joint, pushing ? p.effort : 0.0);
-    const rtc::Termination t = r.session->wait_for(to_ns(every));
+    const rtc::Termination t = wait_to(r, at);
     print_positions(r.model, r.session->how());
     if (t.ended()) return finish(r, report_termination(t));
   }
@@ -261,15 +289,14 @@ void add_report_command(CLI::App& app, int& exit_code) {
                             "communication task.") +
                     kRobotNote);
   add_rtc_options(*report_cmd, *report);
-  report_cmd
-      ->add_option("--seconds", report->seconds,
-                   "How long to run: s, or with a unit (500ms); up to 1e6 s")
-      ->capture_default_str();
-  report_cmd
-      ->add_option("--every", report->every,
-                   "Time between reports: s, or with a unit; at least one sample period")
-      ->capture_default_str();
-  report_cmd->add_flag("--json", report->json, "Print only the latency figures, as JSON");
+  add_run_option(*report_cmd, "--seconds", report->seconds,
+                 "How long to run, up to 1e6 s; the last report is at its end");
+  add_run_option(*report_cmd, "--every", report->every,
+                 "Time between reports, at least one sample period; longer than --seconds: "
+                 "one report, at the end");
+  report_cmd->add_flag("--json", report->json,
+                       "With --realtime: print only the latency figures, as JSON (refused "
+                       "without --realtime)");
   report_cmd->callback(
       [report, &exit_code] { guarded(exit_code, [&] { return run_report(*report); }); });
 }
@@ -281,8 +308,7 @@ void add_calib_command(CLI::App& app, int& exit_code) {
       std::string("Calibrate every joint (STOPCAL) and wait for ALL JOINTS (thesis calib.c).") +
           kRobotNote);
   add_rtc_options(*calib_cmd, *calib);
-  calib_cmd->add_option("--timeout", calib->timeout, "Give up after this long: s, or with a unit")
-      ->capture_default_str();
+  add_run_option(*calib_cmd, "--timeout", calib->timeout, "Give up after this long");
   calib_cmd->callback(
       [calib, &exit_code] { guarded(exit_code, [&] { return run_calib(*calib); }); });
 }
@@ -301,14 +327,9 @@ void add_marsh_command(CLI::App& app, int& exit_code) {
       "marsh", std::string("Zero gravity: the joints follow a push and stay (thesis marsh.c).") +
                    kRobotNote);
   add_rtc_options(*marsh_cmd, *marsh);
-  marsh_cmd
-      ->add_option("--seconds", marsh->seconds,
-                   "How long to run: s, or with a unit (500ms); up to 1e6 s")
-      ->capture_default_str();
-  marsh_cmd
-      ->add_option("--every", marsh->every,
-                   "Time between reports: s, or with a unit; at least one sample period")
-      ->capture_default_str();
+  add_run_option(*marsh_cmd, "--seconds", marsh->seconds, "How long to run, up to 1e6 s");
+  add_run_option(*marsh_cmd, "--every", marsh->every,
+                 "Time between reports, at least one sample period");
   marsh_cmd->add_option("--push", marsh->pushes,
                         "JOINT:EFFORT - a simulated hand pushes joint JOINT (1-based) with EFFORT "
                         "N m or N for the first half of the run; repeatable");

@@ -10,10 +10,9 @@ namespace rccx::tools {
 
 void add_rtc_options(CLI::App& cmd, RtcArgs& a) {
   add_robot_options(cmd, a.robot);
-  cmd.add_option("--period", a.period,
-                 "Sample period, 0.25ms to 56ms (e.g. 1ms, 28ms); default 28ms for the Microbo "
-                 "(its bus needs about 10 ms a sample), 10ms for the others")
-      ->check(not_empty());
+  add_period_option(cmd, a.period,
+                    "Sample period, 0.25ms to 56ms (e.g. 1ms, 28ms); default 28ms for the Microbo "
+                    "(its bus needs about 10 ms a sample), 10ms for the others");
   cmd.add_flag("--realtime", a.realtime,
                "Run in real time (SCHED_FIFO when allowed) instead of simulated time, which is "
                "deterministic and runs as fast as the machine allows");
@@ -30,14 +29,18 @@ rtc::SimulatedRobot SimulatedRobot::make(const RtcArgs& a) {
   rtc::SimulatedRobotOptions o;
   o.calibrated = !a.uncalibrated;
   o.clock = a.realtime ? rtc::ClockKind::real_time : rtc::ClockKind::simulated;
-  if (!a.period.empty()) o.period = parse_period(a.period);
+  if (a.period.given()) o.period = a.period.value;
   o.log = a.log;
   const std::string name = model.name;
   const bool log_given = !a.log.empty();
   try {
     return rtc::SimulatedRobot(std::move(model), o);
   } catch (const rtc::SessionError& e) {
-    throw BadArgument{fmt::format("--period: {}", e.what())};
+    // Name what the user gave: the period, else the robot (file) whose bus needs more.
+    const std::string given = a.period.given()        ? std::string("--period")
+                              : !a.robot.file.empty() ? "--robot-file " + a.robot.file
+                                                      : "--robot " + a.robot.name;
+    throw BadArgument{fmt::format("{}: {}", given, e.what())};
   } catch (const rtc::LogError& e) {
     // RCCX_LOG's errors name it; --log's are named here.
     const bool environment = std::string_view(e.what()).starts_with("RCCX_LOG");

@@ -19,7 +19,7 @@ namespace rccx::tools {
 /// What every control program takes.
 struct RtcArgs {
   RobotChoice robot{"microbo"};
-  std::string period;  ///< empty: the robot's usual period
+  Duration period;  ///< not given: the robot's usual period
   bool realtime = false;
   bool uncalibrated = false;
   std::string log;  ///< CSV of every controlled sample

@@ -28,7 +28,7 @@ struct ViewArgs {
   std::string log;
   std::string address = "127.0.0.1";
   int port = 8080;
-  double seconds = 0.0;
+  Duration seconds{"0s"};  ///< 0: until Ctrl-C
   double rate_hz = 50.0;
   bool fast = false;  ///< simulated time as fast as the machine goes (else paced to the clock)
 };
@@ -92,7 +92,7 @@ int run_replay(const ViewArgs& a) {
   } catch (const view::RunLogError& e) {
     throw BadArgument{fmt::format("--log {}: {}", a.log, e.what())};
   }
-  const Deadline deadline(a.seconds);
+  const Deadline deadline(a.seconds.seconds());
   while (!deadline.over()) std::this_thread::sleep_for(std::chrono::milliseconds(50));
   return kOk;
 }
@@ -111,7 +111,7 @@ int run_robot(const ViewArgs& a) {
   for (std::size_t i = 0; i < goals.size(); ++i) {
     positions.push_back(rccl::Position::joints(fmt::format("P{}", i + 1), goals[i]));
   }
-  const Deadline deadline(a.seconds);
+  const Deadline deadline(a.seconds.seconds());
   int code = kOk;
   for (std::size_t i = 0; !deadline.over(); i = (i + 1) % positions.size()) {
     const rccl::Motion m = arm.move(positions[i]);
@@ -154,7 +154,7 @@ int run_cell(const ViewArgs& a) {
     }
     positions.push_back(std::move(p));
   }
-  const Deadline deadline(a.seconds);
+  const Deadline deadline(a.seconds.seconds());
   for (std::size_t i = 0; !deadline.over(); ++i) {
     std::vector<rccl::EventGate> gates;
     for (std::size_t r = 0; r < model.robots.size(); ++r) {
@@ -226,9 +226,8 @@ void add_view_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--rate", args->rate_hz, "Samples a second sent to the page, 1 .. 200")
       ->check(CLI::Range(1.0, 200.0))
       ->capture_default_str();
-  cmd->add_option("--seconds", args->seconds, "Stop after this many seconds (0: at Ctrl-C)")
-      ->check(CLI::Range(0.0, 1e6))
-      ->capture_default_str();
+  add_duration_option(*cmd, "--seconds", args->seconds, std::chrono::nanoseconds(0),
+                      std::chrono::seconds(1'000'000), "Stop after this long (0: at Ctrl-C)");
   cmd->add_flag("--fast", args->fast,
                 "Run simulated time as fast as the machine goes (default: at the clock's pace); "
                 "with RCCX_LOG=FILE, a quick way to record a run");

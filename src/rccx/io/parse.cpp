@@ -123,6 +123,20 @@ std::size_t parse_joint(std::string_view text, std::string_view what, std::size_
   return static_cast<std::size_t>(value - 1);
 }
 
+namespace {
+
+/// Seconds per unit of a duration's unit ("s", "ms", ...), 0 for no unit known.
+double seconds_per(std::string_view unit) {
+  if (unit == "s") return 1.0;
+  if (unit == "ms") return 1e-3;
+  if (unit == "us") return 1e-6;
+  if (unit == "ns") return 1e-9;
+  if (unit == "min") return 60.0;
+  return 0;
+}
+
+}  // namespace
+
 std::chrono::nanoseconds parse_duration(std::string_view text, std::string_view what, BareUnit bare,
                                         std::chrono::nanoseconds lo, std::chrono::nanoseconds hi) {
   if (text.empty()) throw ParseError(fmt::format("{}: a duration is missing", what));
@@ -130,26 +144,30 @@ std::chrono::nanoseconds parse_duration(std::string_view text, std::string_view 
   bool overflow = false;
   const double value = leading_number(text, used, overflow);
   const std::string_view unit = used == 0 ? std::string_view{} : text.substr(used);
-  double scale = 0;
-  if (unit.empty()) scale = bare == BareUnit::seconds ? 1.0 : 1e-3;
-  if (unit == "s") scale = 1.0;
-  if (unit == "ms") scale = 1e-3;
-  if (unit == "us") scale = 1e-6;
+  const double scale = unit.empty() ? (bare == BareUnit::seconds ? 1.0 : 1e-3) : seconds_per(unit);
   const auto lo_s = std::chrono::duration<double>(lo).count();
   const auto hi_s = std::chrono::duration<double>(hi).count();
   const std::string range = lo_s >= 1.0 || hi_s >= 100.0 ? range_text(lo_s, hi_s, "s")
                                                          : range_text(lo_s * 1e3, hi_s * 1e3, "ms");
+  const char* bare_is = bare == BareUnit::seconds ? "seconds" : "milliseconds";
   if (used == 0 || scale == 0) {
     throw ParseError(fmt::format(
-        "{}: {} is not a duration; write a number with s, ms or us (e.g. 2s, 28ms, 250us){}", what,
-        quoted(text),
-        bare == BareUnit::seconds ? "; a bare number is seconds"
-                                  : "; a bare number is milliseconds"));
+        "{}: {} is not a duration; write a number with ns, us, ms, s or min (e.g. 2s, 28ms, "
+        "250us); a bare number is {}",
+        what, quoted(text), bare_is));
   }
   const double seconds = value * scale;
   if (overflow || !std::isfinite(seconds) || seconds < lo_s || seconds > hi_s) {
-    throw ParseError(
-        fmt::format("{}: {} is out of range; give a duration {}", what, quoted(text), range));
+    // "--period 28" meant as ms is 28 s: say how a bare number is read, and the way out.
+    std::string hint;
+    if (unit.empty() && value > 0 && std::isfinite(value) && bare == BareUnit::seconds &&
+        hi_s < 1.0) {
+      hint = fmt::format(" (a bare number is seconds; for milliseconds write {}ms)", text);
+    } else if (unit.empty()) {
+      hint = fmt::format(" (a bare number is {})", bare_is);
+    }
+    throw ParseError(fmt::format("{}: {} is out of range; give a duration {}{}", what, quoted(text),
+                                 range, hint));
   }
   return std::chrono::duration_cast<std::chrono::nanoseconds>(
       std::chrono::duration<double>(seconds));

@@ -10,8 +10,8 @@
 // Every error is a ParseError whose message reads `WHAT: "TEXT" PROBLEM; WHAT TO DO`.
 //
 //   const double v = io::parse_number(text, "v: the speed", {1e-3, 250.0, "deg/s"});
-//   const std::chrono::nanoseconds p =                   // "28ms", "250us", or "28" (ms)
-//       io::parse_duration(text, "--period", io::BareUnit::milliseconds, 250us, 56ms);
+//   const std::chrono::nanoseconds p =                   // "28ms", "250us", or "0.028" (s)
+//       io::parse_duration(text, "--period", io::BareUnit::seconds, 250us, 56ms);
 //   const std::size_t j = io::parse_joint(text, "j: the joint", model.dof());   // "2" -> 1
 //   io::check_name(name, "--name", 32);                  // letters, digits, _ - .
 #pragma once
@@ -54,8 +54,9 @@ std::size_t parse_joint(std::string_view text, std::string_view what, std::size_
 /// The unit a bare number of a duration is taken in.
 enum class BareUnit : std::uint8_t { seconds, milliseconds };
 
-/// A duration: a number and an optional unit, s, ms or us ("2", "2s", "28ms", "250us"); a bare
-/// number is in `bare`. Refused outside [lo, hi].
+/// A duration: a number and an optional unit, ns, us, ms, s or min ("2", "2s", "28ms", "250us",
+/// "1.5min"); a bare number is in `bare` (every command-line option: seconds, the SI unit).
+/// Refused outside [lo, hi]; the message says how a bare number was read.
 std::chrono::nanoseconds parse_duration(std::string_view text, std::string_view what, BareUnit bare,
                                         std::chrono::nanoseconds lo, std::chrono::nanoseconds hi);
 

@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <cmath>
+
 #include <algorithm>
 #include <utility>
 
@@ -62,12 +64,20 @@ ClockKind Session::clock() const noexcept {
 
 void Session::check_period(std::chrono::nanoseconds p) const {
   const double needed_s = driver_.minimum_period_s();
+  const double max_ms = std::chrono::duration<double, std::milli>(kMaxPeriod).count();
+  if (needed_s * 1e3 > max_ms) {  // no period serves it: the robot file must change, not the period
+    throw SessionError(fmt::format(
+        "robot {}: its link needs {:.1f} ms of bus time a sample, more than the longest sample "
+        "period RTC serves ({:g} ms); no period can serve it: shorten the robot file's bus time "
+        "(exchange_us) or its joints",
+        driver_.model().name, needed_s * 1e3, max_ms));
+  }
   if (std::chrono::duration<double>(p).count() < needed_s) {
     throw SessionError(fmt::format(
-        "sample period {} ms is too short for robot {}: its link needs {:.1f} ms a sample; "
-        "choose at least that",
-        std::chrono::duration<double, std::milli>(p).count(), driver_.model().name,
-        needed_s * 1e3));
+        "sample period {} ms is too short for robot {}: its link needs {:.1f} ms of bus time a "
+        "sample; choose a period from {:.1f} to {:g} ms",
+        std::chrono::duration<double, std::milli>(p).count(), driver_.model().name, needed_s * 1e3,
+        std::ceil(needed_s * 1e4) / 10, max_ms));
   }
   if (p < kMinPeriod || p > kMaxPeriod) {
     using ms = std::chrono::duration<double, std::milli>;
