@@ -68,8 +68,9 @@ TEST(CellRuntime, WaitforTakesEventsAndWaitForADurationTheOtherSpellingStillWork
   c->waitfor(70ms);  // the deprecated spellings forward to the right function
   (void)puma.waitfor(70ms);
   EXPECT_NEAR(c->session("puma").how().time_s - t1, 0.140, 0.0071);
-  const rccl::Motion m = puma.move(world_position(*c, "puma", "P", down_at(kAbove)));
-  EXPECT_EQ(c->wait_for({c->event("puma", m.end())}, 20s), rccl::WaitResult::reached);
+  const rccl::Motion m = puma.dwell(0.1);  // an event to wait for (s)
+  EXPECT_EQ(c->wait_for({c->event("puma", m.end())}, 20s), rccl::WaitResult::reached)
+      << failures_of(puma);
   EXPECT_EQ(puma.wait_for(m.start()), rccl::WaitResult::reached);
 #pragma GCC diagnostic pop
   EXPECT_TRUE(puma.happened(m.end())) << failures_of(puma);
