@@ -165,10 +165,8 @@ MANIP* rcclCreate(const char* name, int /*flags*/) {
     auto m = std::make_unique<rccl_manip>();
     m->name = n;
     m->arm = &c.cell->robot(n);  // std::invalid_argument names the cell's robots
-    const rccx::cell::CellRobot& cr = *c.cell->model().find_robot(n);
-    m->tool =
-        keep_transform(rc::constant(n + "_TOOL", cr.tool.value_or(math::Transform::identity())));
-    m->base_inv = keep_transform(rc::constant(n + "_BASE_INV", cr.base.inverse()));
+    m->tool = keep_transform(c.cell->tool_transform(n));
+    m->base_inv = keep_transform(c.cell->base_inv_transform(n));
     m->tool_frame = keep_transform(c.cell->tool_frame(n));
     auto park_pos = std::make_unique<PositionBox>();
     park_pos->name = n + " park";

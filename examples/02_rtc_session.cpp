@@ -5,7 +5,7 @@
 // degrees and back, sending each sample's target with POSVEL so that it arrives exactly one
 // period later. Then a second session asks for a target beyond joint 3's limit: the
 // communication task refuses to send it, ends the session with a terminate code and leaves the
-// arm holding where it is.
+// arm holding where it is. That breach is deliberate (the program says so before and after).
 //
 // Time is simulated: the 4 s motion runs as fast as the machine allows, the same every run.
 // Run: ./build/release/examples/02_rtc_session
@@ -25,6 +25,11 @@ using namespace std::chrono_literals;
 using namespace rccx::math::literals;
 
 int main() {
+  fmt::print(
+      "Part 1 swings joint 2 by 30 deg and back. Part 2 breaks a limit on purpose: it asks\n"
+      "joint 3 for a target beyond its range, to show RTC refusing it (a terminate code, the\n"
+      "arm holding). That limit breach is deliberate: its message is the lesson, and the\n"
+      "example exits 0 when it comes.\n\n");
   // Below the wire: PID joint servos at 1 kHz on a plant with inertia, friction and gravity.
   const auto arm = hw::make_simulated_arm(kin::builtin_robot("puma560"));
   rtc::ServoDriver driver(*arm);
@@ -65,8 +70,16 @@ int main() {
 
   // A target out of range ends control: nothing is sent, the arm holds, the code says why.
   session.control([](rtc::Control& c) { c.chg().pos(2, 10.0); }, {});
+  fmt::print("\nPart 2: joint 3 asked for 10 rad, beyond its range (deliberate):\n");
   const rtc::Termination t = session.wait_terminated(1s);
   rtc::print_terminate_code(t);
   session.release();
-  return t.code == rtc::TerminateCode::target_position ? 0 : 1;
+  if (t.code != rtc::TerminateCode::target_position) {
+    fmt::print(stderr, "02_rtc_session: the out-of-range target was not refused\n");
+    return 1;
+  }
+  fmt::print(
+      "The limit breach above was deliberate: RTC refused the target and ended control with\n"
+      "that code, as it should. Example done.\n");
+  return 0;
 }

@@ -74,10 +74,10 @@ int main(int argc, char** argv) {
   const auto b = corner("B", 150, 300), c = corner("C", -150, 300), d = corner("D", -150, 250),
              e = corner("E", 150, 250);
   const auto t6 = rccl::t6();
-  const auto p1 = rccl::Position::make("P1", {t6}, {b}, t6);
-  const auto p2 = rccl::Position::make("P2", {t6}, {c}, t6);
-  const auto p3 = rccl::Position::make("P3", {t6}, {d}, t6);
-  const auto p4 = rccl::Position::make("P4", {t6}, {e}, t6);
+  const auto p1 = rccl::Position::make("P1", {t6}, {b});
+  const auto p2 = rccl::Position::make("P2", {t6}, {c});
+  const auto p3 = rccl::Position::make("P3", {t6}, {d});
+  const auto p4 = rccl::Position::make("P4", {t6}, {e});
 
   // waitfor; when watched, simulated time goes at the wall clock's pace: a sample, then its period
   // of sleep (real time would do as well on a quiet machine, but a busy one may overrun).
@@ -103,7 +103,8 @@ int main(int argc, char** argv) {
   arm.set_mode(rccl::Mode::cartesian);
   std::vector<double> round_speed;
   for (int i = 0; i < 3; ++i) {
-    fmt::print("velocity {}, {}\n", tvel_mm, rvel_deg);
+    fmt::print("round {}: setvel {} mm/s along the path, {} deg/s turning\n", i + 1, tvel_mm,
+               rvel_deg);
     round_speed.push_back(tvel_mm);
     for (const auto& p : {p2, p3, p4, p1}) motions.push_back(arm.move(p));
     tvel_mm += 5;

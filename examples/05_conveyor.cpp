@@ -46,10 +46,10 @@ int main() {
   const math::Rot3 pointing = math::Rot3::rot_y(-45_deg) * math::Rot3::rot_x(180_deg);
   const auto grasp = rccl::constant("GRASP", {pointing, {}});
   const auto t6 = rccl::t6();
-  const auto on_belt = rccl::Position::make("ON_BELT", {t6}, {conv, obj, grasp}, t6);
+  const auto on_belt = rccl::Position::make("ON_BELT", {t6}, {conv, obj, grasp});
   // A fixed point 100 mm above the belt to start from: T6 = OVER GRASP.
   const auto over = rccl::constant("OVER", math::Transform::translation(450_mm, -50_mm, -150_mm));
-  const auto above_belt = rccl::Position::make("ABOVE_BELT", {t6}, {over, grasp}, t6);
+  const auto above_belt = rccl::Position::make("ABOVE_BELT", {t6}, {over, grasp});
   fmt::print("{}: belt at {:.0f} mm/s along y\n", on_belt->describe(), kBeltSpeed * 1e3);
 
   arm.start();

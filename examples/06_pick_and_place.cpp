@@ -44,8 +44,8 @@ int main() {
   const auto grasp = rccl::constant("GRASP", {math::Rot3::rot_x(180_deg), {}});
   const auto lift = rccl::constant("LIFT", math::Transform::translation(0, 0, 60_mm));
   const auto t6 = rccl::t6();
-  const auto get = rccl::Position::make("GET", {t6, tool}, {obj, grasp}, tool);
-  const auto over = rccl::Position::make("OVER", {t6, tool}, {obj, lift, grasp}, tool);
+  const auto get = rccl::Position::make("GET", {t6, tool}, {obj, grasp});
+  const auto over = rccl::Position::make("OVER", {t6, tool}, {obj, lift, grasp});
   fmt::print("{}\n{}\n", get->describe(), over->describe());
 
   // Where the measured fingertips are now, against the object's frame (OBJ's planning value).

@@ -51,7 +51,7 @@ int main() {
   const auto t6 = rccl::t6();
   const auto corner = [&](const char* name, double x_mm, double y_mm, double z_mm) {
     const math::Transform T{forward, {x_mm * 1e-3, y_mm * 1e-3, z_mm * 1e-3}};
-    return rccl::Position::make(name, {t6}, {rccl::constant(name, T)}, t6);
+    return rccl::Position::make(name, {t6}, {rccl::constant(name, T)});
   };
   const auto a = corner("A", 450, -150, 200), b = corner("B", 450, 150, 200),
              c = corner("C", 450, 150, 50), d = corner("D", 450, -150, 50);

@@ -21,7 +21,7 @@ int main(int argc, char** argv) {
     const auto t6 = rccl::t6();
     std::vector<rccl::PositionPtr> route;
     for (const char* name : {"A", "B", "C", "A"}) {
-      route.push_back(rccl::Position::make(name, {t6}, {db.constant("puma560", name)}, t6));
+      route.push_back(rccl::Position::make(name, {t6}, {db.constant("puma560", name)}));
     }
     rtc::SimulatedRobot robot(kin::builtin_robot("puma560"));
     rccl::Manipulator arm(*robot.session);

@@ -17,7 +17,7 @@
 // straight lines.
 //
 // The sequence, synchronised by events (the PUMA's motion ends, the Microbo's): a motion of one
-// arm queued with rccl::StartWhen{cell.event(other, m.end())} starts at its first sample after
+// arm queued with cell.after(other, m.end()) starts at its first sample after
 // the other's event, without the program waiting in between:
 //   1. The Microbo backs off; the PUMA goes above the board, descends, closes its hand, lifts the
 //      board off the stage and presents it nearer the Microbo.
@@ -223,7 +223,7 @@ int main(int argc, char** argv) {
   // T6 PTOOL GRASP = BASE_INV(puma) BOARD, tool GRASP: Cartesian moves carry the board straight.
   const auto board_at = [&](const char* name, const math::Transform& board) {
     return rccl::Position::make(name, {t6, ptool, grasp},
-                                {c.in_base_of("puma", rccl::constant(name, board))}, grasp);
+                                {c.in_base_of("puma", rccl::constant(name, board))});
   };
   const auto p_over = board_at("OVER_BOARD", over_home);
   const auto p_grip = board_at("ON_BOARD", board_home);
@@ -231,15 +231,15 @@ int main(int argc, char** argv) {
   const auto p_present = board_at("PRESENT", presented);
   const auto p_moved = board_at("MOVED", presented_end);
 
-  // T6 MTOOL = BASE_INV(microbo) PUMA_TOOL GRASP PAD DOWN: on the pad wherever the PUMA holds it.
-  const auto mtool = rccl::constant("MTOOL", microbo_tool);
-  const auto puma_frame = c.in_base_of("microbo", c.tool_frame("puma"));
+  // T6 TOOL = BASE_INV(microbo) PUMA_TOOL GRASP PAD DOWN: on the pad wherever the PUMA holds it
+  // (a goal in the world for the Microbo's tool: cell.world_goal).
+  const auto puma_frame = c.tool_frame("puma");
   const auto mgrasp = rccl::constant("GRASP", grasp_value);
   std::vector<rccl::PositionPtr> above, touch;
   for (const Pad& pad : kPads) {
     const auto probe = [&](const std::string& name, double z_m) {
       const auto at = rccl::constant(name, down_at(pad.x_mm * 1e-3, pad.y_mm * 1e-3, z_m));
-      return rccl::Position::make(name, {t6, mtool}, {puma_frame, mgrasp, at}, mtool);
+      return c.world_goal("microbo", name, {puma_frame, mgrasp, at});
     };
     above.push_back(probe(std::string("ABOVE_") + pad.name, kProbeAbove));
     touch.push_back(probe(std::string("TOUCH_") + pad.name, 0.0));

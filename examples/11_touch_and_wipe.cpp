@@ -83,8 +83,7 @@ int main(int argc, char** argv) {
   const auto table_frame = rccl::hold("TABLE", Transform::translation(0, 0, -0.200));
   const auto spot = [&](const char* name, double x_mm, double y_mm, double z_mm) {
     const Transform s{math::Rot3::rot_x(180_deg), {x_mm * 1e-3, y_mm * 1e-3, z_mm * 1e-3}};
-    return rccl::Position::make(name, {rccl::t6(), tool}, {table_frame, rccl::constant(name, s)},
-                                tool);
+    return rccl::Position::make(name, {rccl::t6(), tool}, {table_frame, rccl::constant(name, s)});
   };
   const auto above = spot("ABOVE", 400, 100, 30);
   const auto into = spot("INTO", 400, 100, -30);  // 30 mm below where the table is believed

@@ -96,7 +96,7 @@ int main(int argc, char** argv) {
   const auto probe = rccl::constant("PROBE", Transform::translation(0, 0, kProbeLength_m));
   const auto at = [&](const TestPoint& p, double z_mm) {
     const Transform t{math::Rot3::rot_x(180_deg), {p.x_mm * 1e-3, p.y_mm * 1e-3, z_mm * 1e-3}};
-    return rccl::Position::make(p.name, {rccl::t6(), probe}, {rccl::constant(p.name, t)}, probe);
+    return rccl::Position::make(p.name, {rccl::t6(), probe}, {rccl::constant(p.name, t)});
   };
   const auto wait = [&](const rccl::Motion& m) {
     if (arm.waitfor(m.end()) != rccl::WaitResult::reached) {

@@ -22,10 +22,7 @@ inline math::Transform down_at(const math::Vec3& p) {
 inline rccl::PositionPtr world_position(cell::Cell& c, const std::string& robot,
                                         const std::string& name,
                                         const math::Transform& world_goal) {
-  const auto t6 = rccl::t6();
-  const auto tool = rccl::constant(robot + "_tool", c.model().find_robot(robot)->tool.value());
-  const auto goal = c.in_base_of(robot, rccl::constant(name, world_goal));
-  return rccl::Position::make(name, {t6, tool}, {goal}, tool);
+  return c.world_goal(robot, name, world_goal);
 }
 
 /// A robot's tool point in the world for joints q.

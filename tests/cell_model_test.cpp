@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <iterator>
 #include <nlohmann/json.hpp>
 #include <numbers>
 #include <string>
@@ -57,6 +58,88 @@ TEST(CellCvarl, Loads) {
   ASSERT_EQ(overlaps.size(), 1U);
   EXPECT_TRUE(overlaps[0].overlaps());
   EXPECT_GT(overlaps[0].shared_volume_m3, 0.0);
+}
+
+std::string read_text(const fs::path& path) {
+  std::ifstream in(path);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// Cell files are JSON with comments (JSONC); plain JSON is read as well: every shipped cell with
+// its comments taken out loads to the same cell, and is what Python's json module reads.
+TEST(CellCvarl, ShippedCellsLoadWithoutTheirCommentsTooAndPythonReadsThatText) {
+  for (const fs::directory_entry& e : fs::directory_iterator(RCCX_CELLS_DIR)) {
+    if (e.path().extension() != ".json") continue;
+    const std::string with = read_text(e.path());
+    ASSERT_NE(with.find("//"), std::string::npos) << e.path() << ": the test needs its comments";
+    const std::string plain = json::parse(with, nullptr, true, /*ignore_comments=*/true).dump(2);
+    EXPECT_FALSE(json::accept(with));  // strict JSON refuses the comments
+    const cell::CellModel a = cell::load_cell_file(e.path());
+    const cell::CellModel b = cell::parse_cell(plain, e.path().string(), e.path().parent_path());
+    ASSERT_EQ(a.robots.size(), b.robots.size());
+    for (std::size_t i = 0; i < a.robots.size(); ++i) {
+      EXPECT_EQ(a.robots[i].name, b.robots[i].name);
+      EXPECT_EQ(math::max_abs_difference(a.robots[i].base, b.robots[i].base), 0.0);
+    }
+    EXPECT_EQ(a.objects.size(), b.objects.size());
+    const fs::path out = fs::temp_directory_path() / ("rccx_plain_" + e.path().filename().string());
+    std::ofstream(out) << plain;
+    const auto py = rccx::test::run_shell(
+        "python3 -c 'import json,sys; json.load(open(sys.argv[1]))' " + out.string() + " 2>&1");
+    EXPECT_EQ(py.exit_code, 0) << py.out;
+    fs::remove(out);
+  }
+}
+
+// A misspelt key is named with the known key nearest it and its line and column in the file,
+// whether the key it stands for is required (else reported "missing") or optional.
+TEST(CellCvarl, AMisspeltKeyIsNamedWithItsPlaceAndTheNearestKnownKey) {
+  struct Typo {
+    std::string key, typo;
+  };
+  const std::vector<Typo> typos = {
+      {"robots", "robts"},
+      {"base_period_ms", "base_period_sm"},
+      {"collision_margin_m", "colision_margin_m"},
+      {"objects", "object"},
+      {"frames", "framse"},
+      {"period_multiple", "period_multiplier"},
+      {"link_radius_m", "link_radius_mm"},
+      {"base", "bsae"},
+      {"xyz_m", "xyz_mm"},
+      {"rpy_deg", "rpy_dge"},
+      {"movable", "moveable"},
+      {"tool", "tol"},
+  };
+  const std::string text = read_text(kCvarl);
+  for (const Typo& t : typos) {
+    std::string bad = text;
+    const std::size_t at = bad.find("\"" + t.key + "\":");
+    ASSERT_NE(at, std::string::npos) << t.key;
+    bad.replace(at + 1, t.key.size(), t.typo);
+    const auto line = 1 + std::count(bad.begin(), bad.begin() + static_cast<long>(at), '\n');
+    const auto column = at - bad.rfind('\n', at);
+    try {
+      (void)cell::parse_cell(bad, "cells/x.json", kCvarl.parent_path());
+      ADD_FAILURE() << t.typo << " accepted";
+    } catch (const cell::CellFileError& e) {
+      const std::string m = e.what();
+      EXPECT_EQ(m.rfind(fmt::format("cells/x.json:{}:{}: ", line, column), 0), 0U) << m;
+      EXPECT_NE(m.find(fmt::format("unknown key \"{}\"", t.typo)), std::string::npos) << m;
+      EXPECT_NE(m.find(fmt::format("did you mean \"{}\"?", t.key)), std::string::npos) << m;
+    }
+  }
+  // Nothing near: the message lists the keys of that place instead.
+  std::string bad = text;
+  bad.replace(bad.find("\"collision_margin_m\""), 0, "\"zzz\": 1, ");
+  try {
+    (void)cell::parse_cell(bad, "cells/x.json", kCvarl.parent_path());
+    ADD_FAILURE() << "zzz accepted";
+  } catch (const cell::CellFileError& e) {
+    EXPECT_NE(std::string(e.what()).find("unknown key \"zzz\"; the keys here are "),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 // Figure 4.8's demonstration: both arms work on the board. Every point of its top face on a
@@ -363,7 +446,8 @@ TEST(CellFile, BadFilesNameTheKey) {
       ADD_FAILURE() << "row " << i + 1 << " was accepted; should say: " << rows[i].says;
     } catch (const cell::CellFileError& e) {
       const std::string message = e.what();
-      EXPECT_EQ(message.rfind("bad.json: ", 0), 0U) << "row " << i + 1 << ": " << message;
+      // The file's name first (then an unknown key's line and column).
+      EXPECT_EQ(message.rfind("bad.json:", 0), 0U) << "row " << i + 1 << ": " << message;
       EXPECT_NE(message.find(rows[i].says), std::string::npos)
           << "row " << i + 1 << "\nshould say: " << rows[i].says << "\nsaid: " << message;
     }

@@ -39,6 +39,43 @@ TEST(CellRuntime, BuildsEveryRobotOfTheCellFile) {
   }
 }
 
+TEST(CellRuntime, AWorldGoalPutsTheRobotsToolAtTheWorldPose) {
+  const auto c = cell::Cell::load(kCvarl);
+  const math::Transform w = down_at(kAbove + math::Vec3{0.02, -0.01, 0.0});
+  for (const std::string robot : {"puma", "microbo"}) {
+    const rccl::PositionPtr p = c->world_goal(robot, "GOAL", w);
+    const math::Transform tool = c->model().find_robot(robot)->tool.value();
+    // world <- base T6 TOOL is the goal: the equation T6 TOOL = BASE_INV GOAL.
+    EXPECT_LT(math::max_abs_difference(c->base(robot) * p->t6_now() * tool, w), 1e-12) << robot;
+    EXPECT_NE(p->describe().find("T6 " + robot + "_TOOL = " + robot + "_BASE_INV GOAL"),
+              std::string::npos)
+        << p->describe();
+  }
+  EXPECT_THROW((void)c->world_goal("scara", "GOAL", w), std::invalid_argument);
+}
+
+TEST(CellRuntime, WaitforTakesEventsAndWaitForADurationTheOtherSpellingStillWorks) {
+  const auto c = cell::Cell::load(kCvarl);
+  c->start();
+  rccl::Manipulator& puma = c->robot("puma");
+  const double t0 = c->session("puma").how().time_s;
+  c->wait_for(70ms);
+  (void)puma.wait_for(70ms);
+  const double t1 = c->session("puma").how().time_s;
+  EXPECT_NEAR(t1 - t0, 0.140, 0.0071);
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wdeprecated-declarations"
+  c->waitfor(70ms);  // the deprecated spellings forward to the right function
+  (void)puma.waitfor(70ms);
+  EXPECT_NEAR(c->session("puma").how().time_s - t1, 0.140, 0.0071);
+  const rccl::Motion m = puma.dwell(0.1);  // an event to wait for (s)
+  EXPECT_EQ(c->wait_for({c->event("puma", m.end())}, 20s), rccl::WaitResult::reached)
+      << failures_of(puma);
+  EXPECT_EQ(puma.wait_for(m.start()), rccl::WaitResult::reached);
+#pragma GCC diagnostic pop
+  EXPECT_TRUE(puma.happened(m.end())) << failures_of(puma);
+}
+
 TEST(CellRuntime, BothRobotsMoveAtOnceInJointAndCartesianMode) {
   const auto c = cell::Cell::load(kCvarl);
   const std::shared_ptr<double> closest = watch_closest(*c);

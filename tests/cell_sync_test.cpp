@@ -179,6 +179,15 @@ TEST(CellSync, MotionsAskedToEndTogetherEndInTheSameSampleTheFasterSlowed) {
   em.take(microbo);
   EXPECT_EQ(ep.sample(rccl::EventKind::started, a.id), em.sample(rccl::EventKind::started, b.id));
   EXPECT_EQ(ep.sample(rccl::EventKind::ended, a.id), em.sample(rccl::EventKind::ended, b.id));
+  // Their reports say so too: the time of the sample they ended in, not of their setpoints
+  // (the Microbo's run two 28 ms periods ahead, the PUMA's two 7 ms ones).
+  const std::uint64_t end_tick = ep.sample(rccl::EventKind::ended, a.id);
+  const double base_period_s = std::chrono::duration<double>(c->group().period()).count();
+  for (rccl::Manipulator* arm : {&puma, &microbo}) {
+    const rccl::Motion& m = arm == &puma ? a : b;
+    EXPECT_NEAR(arm->report(m).end_s, static_cast<double>(end_tick) * base_period_s, 1e-9);
+  }
+  EXPECT_DOUBLE_EQ(puma.report(a).start_s, microbo.report(b).start_s);
   // The PUMA's 10 mm took as long as the Microbo's 60 mm (0.05 m/s alone: about 0.2 s + its
   // transitions), still on its line.
   const rccl::SegmentReport ra = puma.report(a);

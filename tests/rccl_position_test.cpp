@@ -5,6 +5,9 @@
 
 #include <cstdio>
 #include <random>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "rccx/math/units.hpp"
 #include "rccx/rccl/position.hpp"
@@ -186,6 +189,28 @@ TEST(Position, SolveForMakesTheEquationHoldAtTheGivenT6) {
   EXPECT_THROW((void)p->solve_for(*t6, math::Transform::identity()), EquationError);
   EXPECT_THROW((void)p->solve_for(*rccl::hold("ELSEWHERE"), math::Transform::identity()),
                EquationError);
+}
+
+TEST(Position, WithoutAToolArgumentTheToolIsTheLeftSidesLastTransform) {
+  std::mt19937 rng(11);
+  const auto t6 = rccl::t6();
+  const auto a = rccl::constant("A", random_transform(rng));
+  const auto tool = rccl::constant("TOOL", random_transform(rng));
+  const auto obj = rccl::constant("OBJ", random_transform(rng));
+  // T6 TOOL = OBJ and A T6 = OBJ, each written with and without naming the tool again.
+  const std::vector<std::pair<std::vector<rccl::TransformPtr>, rccl::TransformPtr>> lefts = {
+      {{t6, tool}, tool}, {{a, t6}, t6}, {{t6}, t6}};
+  for (const auto& [lhs, named] : lefts) {
+    const auto once = rccl::Position::make("P", lhs, {obj});
+    const auto twice = rccl::Position::make("P", lhs, {obj}, named);
+    EXPECT_EQ(once->describe(), twice->describe());
+    EXPECT_LT(difference(once->t6_now(), twice->t6_now()), 1e-12) << once->describe();
+    EXPECT_LT(difference(once->tool_now(), twice->tool_now()), 1e-12) << once->describe();
+  }
+  EXPECT_NE(rccl::Position::make("P", {t6, tool}, {obj})->describe().find("(tool TOOL)"),
+            std::string::npos);
+  EXPECT_NE(equation_error([&] { (void)rccl::Position::make("P", {}, {obj}); }).find("no T6"),
+            std::string::npos);
 }
 
 TEST(Position, DescribeWritesTheEquation) {

@@ -15,6 +15,9 @@
  * the table's top (-203 mm in the file) or the tool went more than 1 mm into the table.
  *
  *   RCCX_ROBOT=examples/c/puma560_table.json ./build/release/examples/c_touch_table
+ *
+ * Built in rccx's tree it defaults to that file (TOUCH_TABLE_ROBOT); elsewhere, without
+ * RCCX_ROBOT, it says how to run it and exits 2.
  */
 #include <stdio.h>
 #include <stdlib.h>
@@ -32,9 +35,16 @@ int main()
   double deepest = 1e9;
 
   if (getenv("RCCX_ROBOT") == 0) {
-    fprintf(stderr, "touch_table: set RCCX_ROBOT to examples/c/puma560_table.json\n");
-    return 1;
+#ifdef TOUCH_TABLE_ROBOT
+    setenv("RCCX_ROBOT", TOUCH_TABLE_ROBOT, 1);
+#else
+    fprintf(stderr, "touch_table: needs the PUMA 560 with a wrist sensor and a table\n"
+                    "usage: RCCX_ROBOT=examples/c/puma560_table.json c_touch_table\n");
+    return 2;
+#endif
   }
+  printf("robot file %s: a PUMA 560 with a wrist force sensor over a table\n",
+         getenv("RCCX_ROBOT"));
   table = newtrans("TABLE", hold);
   table->p.z = BELIEVED;
   spot = gentr_rot("SPOT", 400., 100., 0., xunit, 180.);

@@ -409,6 +409,29 @@ ToolSample Cell::tool_sample(std::string_view name) const {
   return s;
 }
 
+rccl::TransformPtr Cell::tool_transform(std::string_view robot) const {
+  const Robot& r = find(robot);
+  return rccl::constant(r.name + "_TOOL", r.tool);
+}
+
+rccl::TransformPtr Cell::base_inv_transform(std::string_view robot) const {
+  const Robot& r = find(robot);
+  return rccl::constant(r.name + "_BASE_INV", r.base_inverse);
+}
+
+rccl::PositionPtr Cell::world_goal(std::string_view robot, std::string name,
+                                   const std::vector<rccl::TransformPtr>& world) const {
+  std::vector<rccl::TransformPtr> rhs{base_inv_transform(robot)};
+  rhs.insert(rhs.end(), world.begin(), world.end());
+  return rccl::Position::make(std::move(name), {rccl::t6(), tool_transform(robot)}, rhs);
+}
+
+rccl::PositionPtr Cell::world_goal(std::string_view robot, std::string name,
+                                   const math::Transform& world_pose) const {
+  auto goal = rccl::constant(name, world_pose);
+  return world_goal(robot, std::move(name), {std::move(goal)});
+}
+
 rccl::TransformPtr Cell::tool_frame(std::string_view leader) const {
   const Robot* r = &find(leader);
   // The Robot outlives the transform only while the cell lives: a transform used after the

@@ -7,7 +7,13 @@
 //   cell.start();                                    // the group's tasks, every generator
 //   rccl::Manipulator& puma = cell.robot("puma");
 //   puma.move(p);  cell.robot("microbo").move(q);    // both move at once
-//   cell.wait_for(2s);                               // simulated time, for the whole cell
+//   cell.waitfor({cell.event("puma", m.end())});     // an event: RCCL's waitfor
+//   cell.wait_for(2s);                               // a duration: std's wait_for
+//
+// Waiting, the same rule on Session, Manipulator and Cell: `waitfor(event)` (one word, RCCL's
+// `waitfor(p->end)`) waits for motion events; `wait_for(duration)` (std::condition_variable's
+// spelling) lets time pass, in simulated time by running those samples. The other spelling
+// with the other argument compiles with a deprecation warning naming the right one.
 //
 // Frames across robots: a robot's tool frame in the world, as the control task commands it,
 // is a functional transform another robot's equation may use (tool_frame, in_base_of):
@@ -109,6 +115,10 @@ class Cell {
   void start();
   /// Lets `d` pass for the whole cell (simulated time: runs those ticks).
   void wait_for(std::chrono::nanoseconds d);
+  [[deprecated("waitfor waits for events; let time pass with wait_for(duration)")]] void waitfor(
+      std::chrono::nanoseconds d) {
+    wait_for(d);
+  }
 
   /// A robot's motion API. Throws std::invalid_argument naming the cell's robots for an
   /// unknown name.
@@ -138,6 +148,20 @@ class Cell {
                                               const rccl::TransformPtr& world_transform) const;
   /// The last published tool frame of a robot (any thread).
   [[nodiscard]] ToolSample tool_sample(std::string_view name) const;
+  /// The robot's cell tool, T6 <- tool (m; identity without one), as a constant transform
+  /// "<robot>_TOOL" (C's mnp_tool).
+  [[nodiscard]] rccl::TransformPtr tool_transform(std::string_view robot) const;
+  /// The robot's base <- world (its base transform inverted) as a constant transform
+  /// "<robot>_BASE_INV" (C's mnp_base_inv).
+  [[nodiscard]] rccl::TransformPtr base_inv_transform(std::string_view robot) const;
+  /// A goal given in the world for the robot's tool: `T6 TOOL = BASE_INV GOAL...`, with
+  /// `world` the goal's product in the world frame (any transforms: another robot's
+  /// tool_frame, a hold, ...), or one world pose (m) as the constant `name`:
+  /// `microbo.move(cell.world_goal("microbo", "PAD", pad_in_world))`.
+  [[nodiscard]] rccl::PositionPtr world_goal(std::string_view robot, std::string name,
+                                             const std::vector<rccl::TransformPtr>& world) const;
+  [[nodiscard]] rccl::PositionPtr world_goal(std::string_view robot, std::string name,
+                                             const math::Transform& world_pose) const;
 
   // --- Synchronisation (Multi-RCCL) ----------------------------------------------------------
   /// An event of `robot`'s motions, for another robot's motion to wait for (StartWhen::after,
@@ -161,6 +185,11 @@ class Cell {
   /// control ended); timeout; session_ended when no robot's control is running.
   rccl::WaitResult waitfor(const std::vector<rccl::EventGate>& gates,
                            std::chrono::nanoseconds timeout = std::chrono::hours(24));
+  [[deprecated("wait_for lets time pass; wait for events with waitfor(gates)")]] rccl::WaitResult
+  wait_for(const std::vector<rccl::EventGate>& gates,
+           std::chrono::nanoseconds timeout = std::chrono::hours(24)) {
+    return waitfor(gates, timeout);
+  }
 
   // --- Sample loop -----------------------------------------------------------------------------
   /// A function the control task runs after each tick's collision check (tests, monitors).

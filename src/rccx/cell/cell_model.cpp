@@ -467,6 +467,40 @@ CellModel parse_cell_json(std::string_view text, std::string_view origin,
   return cell;
 }
 
+/// "line:column" (1-based) of the key `"key":` in the file's text when it appears there once
+/// (the parsed document keeps no positions); empty otherwise.
+std::string key_position(std::string_view text, std::string_view key) {
+  const std::string quoted = fmt::format("\"{}\"", key);
+  std::size_t found = std::string_view::npos;
+  for (std::size_t at = text.find(quoted); at != std::string_view::npos;
+       at = text.find(quoted, at + 1)) {
+    const std::size_t after = text.find_first_not_of(" \t\r\n", at + quoted.size());
+    if (after == std::string_view::npos || text[after] != ':') continue;
+    if (found != std::string_view::npos) return {};  // twice: which one is meant is unknown
+    found = at;
+  }
+  if (found == std::string_view::npos) return {};
+  const std::size_t line_start = text.rfind('\n', found);
+  const std::size_t column = line_start == std::string_view::npos ? found + 1 : found - line_start;
+  const auto line =
+      1 + std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(found), '\n');
+  return fmt::format("{}:{}", line, column);
+}
+
+/// An unknown key's message with the key's line and column after the file's name, as compilers
+/// write it: `cells/x.json:12:5: robot 1: unknown key "robts"; did you mean "robots"?`.
+std::string with_key_position(std::string_view text, std::string_view origin,
+                              const std::string& message) {
+  const std::string_view marker = "unknown key \"";
+  const std::size_t k = message.find(marker);
+  if (k == std::string::npos || message.rfind(origin, 0) != 0) return message;
+  const std::size_t from = k + marker.size();
+  const std::string key = message.substr(from, message.find('"', from) - from);
+  const std::string at = key_position(text, key);
+  if (at.empty()) return message;
+  return fmt::format("{}:{}{}", origin, at, message.substr(origin.size()));
+}
+
 }  // namespace
 
 CellModel parse_cell(std::string_view text, std::string_view origin,
@@ -475,6 +509,8 @@ CellModel parse_cell(std::string_view text, std::string_view origin,
     return parse_cell_json(text, origin, base_dir);
   } catch (const json::exception& e) {  // e.g. a key that is not UTF-8 met by a message
     throw CellFileError(fmt::format("{}: {}", origin, e.what()));
+  } catch (const CellFileError& e) {
+    throw CellFileError(with_key_position(text, origin, e.what()));
   }
 }
 

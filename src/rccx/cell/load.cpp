@@ -49,8 +49,8 @@ void start_circles(Cell& cell, const math::Vec3& centre_m) {
     const double a = 2.0 * math::kPi * c.t_s / kTurn_s;  // runs in the loop: no allocation
     return math::Transform::translation(kRadius_m * std::cos(a), kRadius_m * std::sin(a), 0.0);
   });
-  const auto above = rccl::Position::make("ABOVE", {t6}, {over, grasp}, t6);
-  const auto round = rccl::Position::make("ROUND", {t6}, {circle, over, grasp}, t6);
+  const auto above = rccl::Position::make("ABOVE", {t6}, {over, grasp});
+  const auto round = rccl::Position::make("ROUND", {t6}, {circle, over, grasp});
   for (const std::string& name : cell.robot_names()) {
     rccl::Manipulator& arm = cell.robot(name);
     arm.move(above);  // joint mode

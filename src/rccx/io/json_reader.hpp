@@ -1,6 +1,9 @@
 // One strict reader for the JSON objects of rccx's files (robot files, their RCU section, cell
 // files): key by key, so that every error names where it is ("cvarl: robot 2: \"base\": ..."),
-// and so that an unknown key (a typo such as "upper_mm") is refused instead of silently ignored.
+// and so that an unknown key (a typo such as "upper_mm") is refused instead of silently ignored,
+// naming the known key nearest it ("unknown key \"robts\"; did you mean \"robots\"?"), also
+// when the typo leaves a required key missing ("missing \"robots\" (unknown key \"robts\": did
+// you mean \"robots\"?)").
 // Errors are thrown as `Error` (each file kind has its own exception type), built from one
 // string. Header-only: the file readers include nlohmann/json themselves.
 //
@@ -12,6 +15,7 @@
 #pragma once
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <array>
 #include <cmath>
@@ -24,6 +28,7 @@
 #include <utility>
 
 #include "rccx/io/parse.hpp"
+#include "rccx/io/spelling.hpp"
 
 namespace rccx::io {
 
@@ -49,7 +54,16 @@ class JsonObjectReader {
   }
 
   const json& get(const std::string& key) {
-    if (!has(key)) fail(fmt::format("missing \"{}\"", key));
+    if (!has(key)) {
+      // A required key missing is most often a misspelt one: name that, not only the absence.
+      for (const auto& item : object_.items()) {
+        if (!used_.contains(item.key()) && !nearest_word(item.key(), std::array{key}).empty()) {
+          fail(fmt::format("missing \"{}\" (unknown key \"{}\": did you mean \"{}\"?)", key,
+                           item.key(), key));
+        }
+      }
+      fail(fmt::format("missing \"{}\"", key));
+    }
     return object_.at(key);
   }
 
@@ -137,9 +151,15 @@ class JsonObjectReader {
     return v.get<bool>();
   }
 
+  /// Refuses a key no read asked for, naming the nearest asked-for key, else every one.
   void no_unknown_keys() const {
     for (const auto& item : object_.items()) {
-      if (!used_.contains(item.key())) fail(fmt::format("unknown key \"{}\"", item.key()));
+      if (used_.contains(item.key())) continue;
+      const std::string near = nearest_word(item.key(), used_);
+      fail(near.empty()
+               ? fmt::format("unknown key \"{}\"; the keys here are {}", item.key(),
+                             fmt::join(used_, ", "))
+               : fmt::format("unknown key \"{}\"; did you mean \"{}\"?", item.key(), near));
     }
   }
 

@@ -496,6 +496,10 @@ EventGate Manipulator::gate(const Event& event) const {
   return g;
 }
 
+rtc::Termination Manipulator::wait_for(std::chrono::nanoseconds d) {
+  return session_.wait_for(d);
+}
+
 WaitResult Manipulator::waitfor(const Event& event, std::chrono::nanoseconds timeout) {
   const bool reached =
       happened(event) ||

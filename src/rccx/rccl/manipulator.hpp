@@ -9,6 +9,11 @@
 //   arm.set_mode(rccl::Mode::cartesian);       // setmod('c')
 //   for (auto& p : corners) arm.move(p);       // transitions join the queued segments
 //   arm.waitfor(arm.completed());              // waitfor(completed)
+//   arm.wait_for(500ms);                       // let time pass (simulated: run the samples)
+//
+// Waiting, as on rtc::Session and cell::Cell: `waitfor(event)` (RCCL's word) waits for a motion
+// event, `wait_for(duration)` (std's) lets time pass; the other spelling with the other
+// argument compiles with a deprecation warning naming the right one.
 //
 // Requests reach the sample loop through a lock-free queue; events (start, end, failure) come
 // back the same way. Waiting lets simulated time run, so a simulated program is deterministic.
@@ -158,6 +163,18 @@ class Manipulator {
   /// Waits for `event` (in simulated time: runs the samples until then).
   WaitResult waitfor(const Event& event,
                      std::chrono::nanoseconds timeout = std::chrono::hours(24 * 365));
+  [[deprecated("wait_for lets time pass; wait for an event with waitfor(event)")]] WaitResult
+  wait_for(const Event& event, std::chrono::nanoseconds timeout = std::chrono::hours(24 * 365)) {
+    return waitfor(event, timeout);
+  }
+  /// Lets `d` pass (the session's wait_for: in simulated time, runs those samples). Returns
+  /// the session's termination if control ended meanwhile, an empty one otherwise.
+  rtc::Termination wait_for(std::chrono::nanoseconds d);
+  [[deprecated(
+      "waitfor waits for an event; let time pass with wait_for(duration)")]] rtc::Termination
+  waitfor(std::chrono::nanoseconds d) {
+    return wait_for(d);
+  }
   /// True when `event` has happened.
   [[nodiscard]] bool happened(const Event& event) const noexcept;
   /// An event of this arm as another arm's motion may wait for it (StartWhen::after), read

@@ -38,6 +38,12 @@ void Position::append(Factors& to, const TransformPtr& t, bool inverted, std::ui
 }
 
 PositionPtr Position::make(std::string name, const std::vector<TransformPtr>& lhs,
+                           const std::vector<TransformPtr>& rhs) {
+  // An empty left side is refused by make() below for its missing T6.
+  return make(std::move(name), lhs, rhs, lhs.empty() ? nullptr : lhs.back());
+}
+
+PositionPtr Position::make(std::string name, const std::vector<TransformPtr>& lhs,
                            const std::vector<TransformPtr>& rhs, const TransformPtr& tool) {
   const auto fail = [&](std::string_view why) {
     return EquationError(

@@ -51,6 +51,11 @@ class Position {
   /// transforms.
   static PositionPtr make(std::string name, const std::vector<TransformPtr>& lhs,
                           const std::vector<TransformPtr>& rhs, const TransformPtr& tool);
+  /// The same with the tool the left side's last transform, as most equations have it (T6
+  /// itself when nothing follows it), so that it is named once:
+  /// `make("GET", {t6, tool}, {obj, grasp})` is `T6 TOOL = OBJ GRASP (tool TOOL)`.
+  static PositionPtr make(std::string name, const std::vector<TransformPtr>& lhs,
+                          const std::vector<TransformPtr>& rhs);
   /// A position given in joint values (rad / m), like RCCL's park.
   static PositionPtr joints(std::string name, const kin::JointVector& q);
 

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "rccx/rtc/types.hpp"
+
 namespace rccx::rccl {
 namespace {
 
@@ -18,6 +20,10 @@ void check_rigid(const std::string& name, const math::Transform& value) {
 }
 
 }  // namespace
+
+double SampleContext::sample_time_s() const noexcept {
+  return how != nullptr ? how->time_s : t_s;
+}
 
 std::string_view to_string(TransformKind kind) noexcept {
   switch (kind) {

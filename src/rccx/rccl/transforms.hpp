@@ -42,6 +42,10 @@ struct SampleContext {
   /// (t_s ahead of or behind it, to plan a transition with a moving goal's velocity): the
   /// function is called afresh (not cached for the sample), with `how` still this sample's.
   bool predicted = false;
+  /// The time of the sample itself (How::time_s), s: what motion events and reports say, so
+  /// that robots sampled at different periods (pipelines of different lengths) ending in the
+  /// same tick report the same time. Outside a session: t_s.
+  [[nodiscard]] double sample_time_s() const noexcept;
 };
 
 /// A functional transform's function: its value at that sample (m, rad). Runs in the sample

@@ -215,7 +215,7 @@ void TrajectoryGenerator::start_waiting(const SampleContext& ctx, double t) {
   Rendezvous* rv = queue_.waiting()->together;
   const double eps = 1e-9;
   // Samples are for the tick's time (How); the setpoint time runs the pipeline ahead of it.
-  const double now = ctx.how != nullptr ? ctx.how->time_s : t;
+  const double now = ctx.how != nullptr ? ctx.sample_time_s() : t;
   if (rv != nullptr && !(rv->start_s() >= 0.0 && now >= rv->start_s() - eps)) {
     tell_rendezvous(ctx, t, now);
     return;
@@ -276,7 +276,7 @@ void TrajectoryGenerator::begin_transition(const SampleContext& ctx, double tB, 
   rep = SegmentReport{};
   rep.id = next.id;
   rep.mode = next.kind == Segment::Kind::cartesian ? Mode::cartesian : Mode::joint;
-  rep.start_s = ctx.t_s;
+  rep.start_s = ctx.sample_time_s();
   rep.duration_s = next.T;
 }
 
@@ -314,7 +314,7 @@ void TrajectoryGenerator::end_motion(const Segment& s, const SampleContext& ctx,
                                      std::string_view text) noexcept {
   if (s.id == 0) return;
   SegmentReport& rep = queue_.report_slot(s.id);
-  if (rep.id == s.id) rep.end_s = ctx.t_s;
+  if (rep.id == s.id) rep.end_s = ctx.sample_time_s();
   trajectory::release_position(s.position, s.borrowed_position);
   queue_.emit(EventKind::ended, s.id, ctx, kin::IkStatus::ok, 0, text);
   ledger_.mark_ended(s.id);
@@ -344,7 +344,7 @@ void TrajectoryGenerator::fail(std::uint64_t id, const SampleContext& ctx, kin::
   SegmentReport& rep = queue_.report_slot(id);
   rep.id = id;
   rep.failed = true;
-  rep.end_s = ctx.t_s;
+  rep.end_s = ctx.sample_time_s();
   queue_.emit(EventKind::failed, id, ctx, status, joint, std::string_view(text.data()));
   // Everything from the motion running now to the last one queued ends here.
   std::uint64_t last = id;

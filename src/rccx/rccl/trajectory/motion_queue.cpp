@@ -103,7 +103,7 @@ void MotionQueue::emit(EventKind kind, std::uint64_t id, const SampleContext& ct
   MotionEvent e;
   e.kind = kind;
   e.id = id;
-  e.t_s = ctx.t_s;
+  e.t_s = ctx.sample_time_s();
   e.sample = ctx.sample;
   e.status = status;
   e.joint = joint;

@@ -77,7 +77,7 @@ inline constexpr std::string_view kNextmoveText = "ended by nextmove";
 struct MotionEvent {
   EventKind kind = EventKind::started;
   std::uint64_t id = 0;
-  double t_s = 0.0;
+  double t_s = 0.0;  ///< the time of the sample it happened in (How::time_s), s
   std::uint64_t sample = 0;
   kin::IkStatus status = kin::IkStatus::ok;  ///< failed: why, when the kinematics said so
   int joint = 0;                             ///< failed: the 1-based joint concerned, or 0
@@ -89,8 +89,11 @@ struct MotionEvent {
 struct SegmentReport {
   std::uint64_t id = 0;
   Mode mode = Mode::joint;
-  double start_s = 0.0;     ///< when its transition in began
-  double end_s = 0.0;       ///< when its transition out ended
+  /// When its transition in began and its transition out ended: the time of those samples
+  /// (How::time_s, s), not of their setpoints, which run the robot's pipeline ahead; robots
+  /// ending in the same tick report the same end_s whatever their periods.
+  double start_s = 0.0;
+  double end_s = 0.0;
   double duration_s = 0.0;  ///< the straight part's nominal length T
   /// Outside transitions: the largest distance of the commanded and of the measured tool
   /// point from the straight segment (m), and the largest angle between the measured and the
