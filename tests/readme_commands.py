@@ -39,6 +39,9 @@ class Expect:
     skip: str = ""  # why it is not run here
     file: str = ""  # a command that prints nothing: the regex is searched in the file it wrote
     timeout_s: float = 120.0
+    # A real-time command on a loaded machine may overrun and say so with exit 1 (the README's
+    # "control was restarted" policy): accepted, and said, when this line is in its output.
+    loaded: str = ""
 
 
 ADDRESS = r"http://127\.0\.0\.1:\d+"
@@ -59,7 +62,8 @@ TABLE = {
     "rccx kin ik --robot microbo --T 1,0,0,0.325,0,-1,0,0.15,0,0,-1,0.25 --config n":
         Expect(0, r"^ +d3 = +0\.35794\d* m"),
     "rccx report --seconds 2": Expect(0, r"^t +[\d.]+ s +theta1 +-?[\d.]+ deg d2 +[\d.]+ mm"),
-    "rccx report --robot puma560 --realtime --period 1ms --seconds 10": Expect(0, r"latency"),
+    "rccx report --robot puma560 --realtime --period 1ms --seconds 10":
+        Expect(0, r"latency", loaded=r"^report: control was restarted \d+ times? after overruns"),
     "rccx calib --uncalibrated": Expect(0, r"^ALL JOINTS calibrated after"),
     "rccx limp": Expect(0, r"^arm power off"),
     "rccx marsh --push 3:60": Expect(0, r"^zero gravity"),
@@ -169,7 +173,9 @@ def check(line, expect, env, cwd, network):
     else:
         code, out = run_to_end(argv, expect, env, cwd)
     problems = []
-    if code != expect.code:
+    if code == 1 and expect.loaded and re.search(expect.loaded, out, re.MULTILINE):
+        print(f"note  exit 1 on this loaded machine: {re.search(expect.loaded, out, re.M)[0]}")
+    elif code != expect.code:
         problems.append(f"exit code {code}, expected {expect.code}")
     text = out
     if expect.file:

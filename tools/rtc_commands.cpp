@@ -147,7 +147,9 @@ int run_report(const ReportArgs& a) {
   if (!t.ended()) t = r.session->release();
   if (a.realtime) print_latency(a, r, restarts);  // up to the end, even when control ended early
   const int code = report_termination(t);
-  if (restarts > 0) io::eprint("report: control was restarted {} times after overruns\n", restarts);
+  if (restarts > 0)
+    io::eprint("report: control was restarted {} time{} after overruns\n", restarts,
+               restarts == 1 ? "" : "s");
   return finish(r, restarts > 0 ? kFailure : code);
 }
 
