@@ -197,9 +197,10 @@ TEST_F(BadInput, ControlPrograms) {
 // One log a robot of a cell, named by its name in the cell: three robots of one model, three
 // files, each with its own header and rows.
 TEST_F(BadInput, ACellLogsOneFileARobotNamedByItsName) {
-  const std::string command = fmt::format("timeout -k 5 60 env RCCX_LOG={} {} cell-load --robots 3 "
-                                          "--seconds 0.3",
-                                          path("run.csv"), RCCX_CLI);
+  const std::string command = fmt::format(
+      "timeout -k 5 60 env RCCX_LOG={} {} cell-load --robots 3 "
+      "--period 10ms --seconds 0.3",
+      path("run.csv"), RCCX_CLI);
   const CommandRun r = run(command);
   ASSERT_EQ(r.exit_code, 0) << r.out;
   std::vector<std::string> names;
@@ -218,7 +219,8 @@ TEST_F(BadInput, ACellLogsOneFileARobotNamedByItsName) {
     EXPECT_NE(header.find("robot=puma560 "), std::string::npos) << header;
     int rows = 0;
     for (std::string line; std::getline(in, line);) ++rows;
-    EXPECT_NEAR(rows, 1 + 30, 1) << f << ": the column line and a row a 10 ms sample";
+    // The column line and a row a 10 ms sample (and the few samples of the other robots' close).
+    EXPECT_NEAR(rows, 1 + 30, 3) << f;
   }
 }
 

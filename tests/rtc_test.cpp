@@ -1,5 +1,6 @@
 // RTC sessions in simulated time (and a few in real time): the pipeline of thesis figure 4.7,
 // limit checks per checking mode, faults, the watchdog, release and control again, Ctrl-C.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <atomic>

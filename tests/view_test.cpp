@@ -475,7 +475,7 @@ TEST(RunLog, TheHeaderNamesTheRobotItIsDrawnAs) {
   const kin::RobotModel microbo = kin::builtin_robot("microbo");
   kin::RobotModel bent = puma;  // a robot file that says it is the PUMA, with another link
   bent.joints[2].dh.a_m += 0.01;
-  for (const auto* other : {&microbo, &bent}) {
+  for (const kin::RobotModel* other : {&microbo, static_cast<const kin::RobotModel*>(&bent)}) {
     try {
       (void)view::log_robot(headed, other, "--robot-file x.json");
       ADD_FAILURE() << "a log of the PUMA drawn as " << other->name;
@@ -511,7 +511,7 @@ TEST(ViewCli, PlotAndReplayDrawALogAsItsOwnRobotAndRefuseAnother) {
   EXPECT_EQ(r.exit_code, 0) << r.out;
   EXPECT_NE(r.out.find("robot puma560 (puma560)"), std::string::npos) << r.out;
   std::filesystem::remove(svg);
-  for (const std::string command :
+  for (const std::string& command :
        {fmt::format("plot {} --robot microbo -o {}", run.string(), svg),
         fmt::format("view --log {} --robot microbo --port 0 --seconds 1", run.string())}) {
     r = test::rccx_run(command);

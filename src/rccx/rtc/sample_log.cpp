@@ -64,9 +64,11 @@ std::string kinematics_fingerprint(const kin::RobotModel& model) {
 
 LogHeader LogHeader::of(const kin::RobotModel& model, std::string_view name,
                         std::chrono::nanoseconds period, bool simulated) {
-  return LogHeader{model.name,      kinematics_fingerprint(model),
+  return LogHeader{model.name,
+                   kinematics_fingerprint(model),
                    std::string(name.empty() ? std::string_view(model.name) : name),
-                   period.count(),  simulated,
+                   period.count(),
+                   simulated,
                    RCCX_VERSION_STRING};
 }
 
@@ -103,8 +105,10 @@ std::optional<LogHeader> LogHeader::parse(std::string_view line) {
     }
   }
   const std::initializer_list<std::pair<const char*, bool>> required = {
-      {"robot", !h.robot.empty()}, {"kinematics", h.kinematics.size() == 16},
-      {"name", !h.name.empty()},   {"period_ns", h.period_ns > 0},
+      {"robot", !h.robot.empty()},
+      {"kinematics", h.kinematics.size() == 16},
+      {"name", !h.name.empty()},
+      {"period_ns", h.period_ns > 0},
       {"clock", clock}};
   for (const auto& [key, given] : required) {
     if (!given) throw LogError(fmt::format("the header line has no valid {}=", key));
@@ -131,8 +135,7 @@ SampleLog::SampleLog(const std::filesystem::path& file, const kin::RobotModel& m
   // The header goes with the first rows: a disk that is full from the start is a write that
   // fails (said at once, the log not saved), not a bad file name.
   std::string head = header.line();
-  fmt::format_to(std::back_inserter(head), "{}\n",
-                 fmt::join(sample_log_columns(model.dof()), ","));
+  fmt::format_to(std::back_inserter(head), "{}\n", fmt::join(sample_log_columns(model.dof()), ","));
   writer_ = std::thread([this, head = std::move(head)]() mutable { write_loop(std::move(head)); });
 }
 

@@ -51,9 +51,9 @@ class LogError : public std::runtime_error {
 /// `1` is the format's version; then key=value words, in this order (a reader ignores keys it
 /// does not know). A value has no space: a space is written %20, a % %25.
 struct LogHeader {
-  std::string robot;       ///< the robot file's "name" (a shipped robot's: `rccx kin robots`)
-  std::string kinematics;  ///< kinematics_fingerprint() of the robot, 16 hex digits
-  std::string name;        ///< the robot's name in its cell (its model's name when alone)
+  std::string robot;           ///< the robot file's "name" (a shipped robot's: `rccx kin robots`)
+  std::string kinematics;      ///< kinematics_fingerprint() of the robot, 16 hex digits
+  std::string name;            ///< the robot's name in its cell (its model's name when alone)
   std::int64_t period_ns = 0;  ///< the robot's sample period, ns
   bool simulated = true;       ///< clock=simulated or clock=realtime
   std::string rccx;            ///< the version of rccx that wrote it

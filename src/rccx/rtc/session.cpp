@@ -123,7 +123,8 @@ Session& SessionGroup::add(Driver& driver, int multiple, std::string_view name) 
     throw SessionError(fmt::format("robot {}: a period multiple of {}; give 1 to 1000",
                                    driver.model().name, multiple));
   }
-  auto s = std::unique_ptr<Session>(new Session(driver, clock_, multiple, unique_name(driver, name)));
+  auto s =
+      std::unique_ptr<Session>(new Session(driver, clock_, multiple, unique_name(driver, name)));
   clock_->add(*s->channel_);
   sessions_.push_back(std::move(s));
   return *sessions_.back();
@@ -136,9 +137,10 @@ std::string SessionGroup::unique_name(const Driver& driver, std::string_view nam
                        [&n](const auto& s) { return s->name() == n; });
   };
   if (!name.empty() && taken(base)) {
-    throw SessionError(fmt::format("a robot named \"{}\" is in the group already; give each "
-                                   "robot its own name",
-                                   base));
+    throw SessionError(
+        fmt::format("a robot named \"{}\" is in the group already; give each "
+                    "robot its own name",
+                    base));
   }
   std::string unique = base;
   for (int k = 2; taken(unique); ++k) unique = fmt::format("{}-{}", base, k);

@@ -59,18 +59,16 @@ RunLog parse_run_log(std::string_view text, std::string_view origin) {
       }
       log.dof = (cells.size() - 8) / 2;
       if (log.dof > kin::kMaxJoints) {
-        throw RunLogError(
-            fmt::format("{}:{}: {} joints; rccx logs at most {}", origin, line_no, log.dof,
-                        kin::kMaxJoints));
+        throw RunLogError(fmt::format("{}:{}: {} joints; rccx logs at most {}", origin, line_no,
+                                      log.dof, kin::kMaxJoints));
       }
       header = rtc::sample_log_columns(log.dof);         // the columns rtc::SampleLog writes
       header.erase(header.begin(), header.begin() + 2);  // t and seg, checked above
       for (std::size_t i = 0; i < header.size(); ++i) {
         if (cells[i + 2] != header[i]) {
           throw RunLogError(fmt::format("{}:{}: column {} is {}, expected {}: not {}", origin,
-                                        line_no, i + 3,
-                                        io::quoted(cells[i + 2].substr(0, 40)), header[i],
-                                        kExpected));
+                                        line_no, i + 3, io::quoted(cells[i + 2].substr(0, 40)),
+                                        header[i], kExpected));
         }
       }
       continue;

@@ -38,7 +38,7 @@ struct RunRow {
 };
 
 struct RunLog {
-  std::string origin;                     ///< the file, for messages
+  std::string origin;                    ///< the file, for messages
   std::optional<rtc::LogHeader> header;  ///< none in a log written before headers
   std::size_t dof = 0;
   std::vector<RunRow> rows;
