@@ -33,8 +33,9 @@
  * robots` lists them) or a robot file (a path ending in .json); default "microbo".
  * RCCX_LOG = FILE writes a CSV row per controlled sample: t, segment (the motion's number,
  * 1, 2, ... in the order of the move() and stop() calls since rccl_open; 0 at rest), commanded
- * and measured joints, the commanded tool pose. RCCX_DB = the position database teach() reads
- * and writes (default rccx.db in the working directory).
+ * and measured joints, the commanded tool pose, after a header line naming the robot; a log
+ * that cannot be written makes rccl_close() return RTC_E_LOG. RCCX_DB = the position database
+ * teach() reads and writes (default rccx.db in the working directory).
  *
  * Errors. No call aborts the program. A call that fails returns nonzero (or NULL), sets
  * rtc_error and keeps a message (rtc.h); the calls a 1986 program did not check (all but
@@ -347,8 +348,9 @@ int rccl_control(void);
  * of these that applies: RTC_E_TERMINATED when control had ended by itself (a limit, a
  * fault, Ctrl-C); RTC_E_MOTION when a motion failed or was cancelled during the session; the
  * code of the first move() that was refused during the session (RTC_E_UNREACHABLE, ...);
- * RTC_E_SEQUENCE when no session is open. The session is closed in every case; rccl_open()
- * may follow.
+ * RTC_E_LOG when the RCCX_LOG file could not be written whole (a full disk, an I/O error: the
+ * log is lost, the file left as it was); RTC_E_SEQUENCE when no session is open. The session
+ * is closed in every case; rccl_open() may follow.
  */
 int rccl_close(int power_off);
 

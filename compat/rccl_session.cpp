@@ -321,6 +321,8 @@ const char* rtc_error_name(int code) {
       return "RTC_E_INTERNAL";
     case RTC_E_NOT_YET:
       return "RTC_E_NOT_YET";
+    case RTC_E_LOG:
+      return "RTC_E_LOG";
     default:
       return "unknown";
   }
@@ -331,7 +333,7 @@ const char* rtc_error_message(void) {
 }
 
 void print_rtc_error(int code, int /*flags*/) {
-  static constexpr std::array<const char*, 11> kMeaning = {
+  static constexpr std::array<const char*, 12> kMeaning = {
       "no error",
       "a call out of order (open, control, move, close)",
       "no such robot, or it cannot be simulated",
@@ -343,6 +345,7 @@ void print_rtc_error(int code, int /*flags*/) {
       "control ended",
       "an unexpected failure inside rccx",
       "not done by this version of rccx yet",
+      "the sample log (RCCX_LOG) is lost",
   };
   const char* meaning = code >= 0 && code < static_cast<int>(kMeaning.size())
                             ? kMeaning[static_cast<std::size_t>(code)]
@@ -437,8 +440,13 @@ int rccl_close(int power_off) {
     const rtc::Termination t =
         a.controlling ? a.arm.stop_control() : a.robot.session->termination();
     std::string why;
-    const int code = session_verdict(a, t, why);
+    int code = session_verdict(a, t, why);
     a.robot.session->close(power_off != 0);
+    // The log last: a session that went wrong says that first; its log's problem is on stderr.
+    if (const std::string lost = a.robot.finish(); !lost.empty() && code == RTC_OK) {
+      code = RTC_E_LOG;
+      why = fmt::format("the sample log is lost: {}", lost);
+    }
     return code == RTC_OK ? RTC_OK : fail(code, "rccl_close: " + why, Say::quiet);
   });
 }

@@ -28,6 +28,8 @@ extern "C" {
 #define RTC_E_TERMINATED 8  /* control ended by itself: a limit, a fault, Ctrl-C */
 #define RTC_E_INTERNAL 9    /* an unexpected failure inside rccx (the message says which) */
 #define RTC_E_NOT_YET 10    /* a call rccx declares but does not do yet */
+#define RTC_E_LOG 11        /* the RCCX_LOG file is lost: a write failed (full disk, I/O error) \
+                               or rows were dropped; the file is left as it was */
 
 /** The code of the last error (RTC_OK until one happens). */
 extern int rtc_error;
@@ -53,7 +55,8 @@ const char* rtc_error_name(int code);
  *
  * The robot: RCCX_ROBOT names a shipped robot ("microbo", "puma560", ...) or a robot file
  * (a path, or a name ending in .json); default microbo, at its usual period (28 ms; 10 ms for
- * the others). RCCX_LOG=FILE writes a CSV row per controlled sample.
+ * the others). RCCX_LOG=FILE writes a CSV row per controlled sample, after a header line that
+ * names the robot (README.md); rtc_close() returns RTC_E_LOG when it could not be written.
  *
  * Time: in REAL time by default; RCCX_CLOCK=simulated selects simulated time (deterministic,
  * faster than real time), where time passes only inside rtc_wait() and
@@ -240,6 +243,9 @@ int rtc_open(void);                        /* opens the session: the arm is read
 int rtc_control(RTC_FN fn1, RTC_FN fn2);   /* starts fn1 / fn2 each sample; after rtc_open() */
 int rtc_release(int power_off);            /* stops control (the arm holds, or power off) */
 int rtc_close(int power_off);              /* releases if needed and closes the session */
+/* rtc_close returns RTC_OK, or RTC_E_TERMINATED (control had ended by itself), RTC_E_SEQUENCE
+   (no session open), or RTC_E_LOG when RCCX_LOG's log could not be written whole: a program
+   that checks it knows its log is lost. release() closes too and returns the same. */
 /* 1983. control() opens the session if it is not open; release() stops control, prints msg
    (when not NULL) and then mess (when not NULL) on stdout, one line each, and closes the
    session. The arm holds (1983 shut it off: rtc_release(1) does that). Both return RTC_OK or an

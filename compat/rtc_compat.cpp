@@ -92,7 +92,8 @@ struct Rtc {
   Rtc& operator=(const Rtc&) = delete;
   ~Rtc();
   void stop_watcher() noexcept;
-  void close_now(bool power_off) noexcept;
+  /// Closes the session; what went wrong with RCCX_LOG's log ("" when whole or none).
+  std::string close_now(bool power_off) noexcept;
 };
 
 std::atomic<bool> g_open{false};
@@ -114,23 +115,26 @@ void Rtc::stop_watcher() noexcept {
   stop_watching.store(false);
 }
 
-void Rtc::close_now(bool power_off) noexcept {
+std::string Rtc::close_now(bool power_off) noexcept {
   stop_watcher();
+  std::string lost;
   if (robot) {
     try {
       robot->session->close(power_off);
-      (void)robot->finish();  // RCCX_LOG's problems are said on stderr
+      lost = robot->finish();  // already said on stderr
     } catch (...) {
+      lost = "the log could not be closed";
     }
     robot.reset();
   }
   controlled = false;
   opened_by_control = false;
   g_open.store(false);
+  return lost;
 }
 
 Rtc::~Rtc() {
-  close_now(false);
+  (void)close_now(false);
 }
 
 // ------------------------------------------------------------------------------------------
@@ -349,7 +353,7 @@ int open_session(const char* call) {
 }
 
 void run_at_exit() {
-  rtc_state().close_now(false);
+  (void)rtc_state().close_now(false);  // too late to return it: said on stderr
 }
 
 int start_control(const char* call, RTC_FN f1, RTC_FN f2) {
@@ -424,6 +428,13 @@ int end_result(const char* call, const rtc::Termination& t) {
   return rtc_fail(RTC_E_TERMINATED, fmt::format("{}: {}", call, describe_end(t)), false);
 }
 
+/// What a call that closed the session returns: `rc`, else RTC_E_LOG when the log is `lost`
+/// (its problem, said on stderr already by the log).
+int closed(const char* call, int rc, const std::string& lost) {
+  if (rc != RTC_OK || lost.empty()) return rc;
+  return rtc_fail(RTC_E_LOG, fmt::format("{}: the sample log is lost: {}", call, lost), false);
+}
+
 }  // namespace
 
 bool rtc_session_open() noexcept {
@@ -472,7 +483,7 @@ int control(RTC_FN fn1, RTC_FN fn2) {
           s.opened_by_control = true;
         }
         const int rc = start_control("control", fn1, fn2);
-        if (rc != RTC_OK && s.opened_by_control && !s.controlled) s.close_now(false);
+        if (rc != RTC_OK && s.opened_by_control && !s.controlled) (void)s.close_now(false);
         return rc;
       },
       RTC_E_ROBOT);
@@ -499,8 +510,8 @@ int release(const char* msg) {
     if (msg != nullptr) std::printf("%s\n", msg);
     if (mess != nullptr) std::printf("%s\n", mess);
     std::fflush(stdout);
-    s.close_now(false);
-    return end_result("release", t);
+    const int rc = end_result("release", t);
+    return closed("release", rc, s.close_now(false));
   });
 }
 
@@ -510,8 +521,7 @@ int rtc_close(int power_off) {
     if (!s.robot) return rtc_fail(RTC_E_SEQUENCE, "rtc_close: no RTC session is open");
     int rc = RTC_OK;
     if (s.controlled) rc = end_result("rtc_close", stop_control(power_off != 0));
-    s.close_now(power_off != 0);
-    return rc;
+    return closed("rtc_close", rc, s.close_now(power_off != 0));
   });
 }
 

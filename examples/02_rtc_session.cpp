@@ -74,6 +74,11 @@ int main() {
   const rtc::Termination t = session.wait_terminated(1s);
   rtc::print_terminate_code(t);
   session.release();
+  session.close();  // RCCX_LOG's log put in place
+  if (!session.log_problem().empty()) {
+    fmt::print(stderr, "02_rtc_session: the sample log is lost: {}\n", session.log_problem());
+    return 1;
+  }
   if (t.code != rtc::TerminateCode::target_position) {
     fmt::print(stderr, "02_rtc_session: the out-of-range target was not refused\n");
     return 1;

@@ -123,5 +123,5 @@ int main() {
                samples, lag_max * 1e3, kLagBound * 1e3);
     return 1;
   }
-  return 0;
+  return robot.finish_logs("05_conveyor") ? 0 : 1;  // RCCX_LOG's log whole
 }

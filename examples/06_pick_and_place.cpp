@@ -129,5 +129,5 @@ int main() {
                kPlacedWithin * 1e3);
     return 1;
   }
-  return 0;
+  return robot.finish_logs("06_pick_and_place") ? 0 : 1;  // RCCX_LOG's log whole
 }

@@ -167,5 +167,5 @@ int main() {
     if (t.ended()) rtc::print_terminate_code(t, stderr);
     return 1;
   }
-  return 0;
+  return robot.finish_logs("07_puma560") ? 0 : 1;  // RCCX_LOG's log whole
 }

@@ -54,5 +54,5 @@ int main(int argc, char** argv) {
                s.value.p.y * 1e3, s.value.p.z * 1e3);
   }
   const bool ok = t.ended_by_exit && !arm.stop_control().ended();
-  return ok ? 0 : 1;
+  return robot.finish_logs("08_teach") && ok ? 0 : 1;  // RCCX_LOG's log whole
 }

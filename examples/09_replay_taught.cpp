@@ -39,7 +39,8 @@ int main(int argc, char** argv) {
                  route[i + 1]->name(), r.end_s - r.start_s, r.max_measured_path_error_m * 1e3);
     }
     for (const auto& f : arm.failures()) fmt::print(stderr, "{}\n", f.message());
-    return w == rccl::WaitResult::reached && !arm.stop_control().ended() ? 0 : 1;
+    const bool ok = w == rccl::WaitResult::reached && !arm.stop_control().ended();
+    return robot.finish_logs("09_replay_taught") && ok ? 0 : 1;  // RCCX_LOG's log whole
   } catch (const rccl::DatabaseError& e) {
     fmt::print(stderr, "{}\n(run 08_teach first)\n", e.what());
     return 1;

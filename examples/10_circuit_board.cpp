@@ -491,5 +491,15 @@ int main(int argc, char** argv) {
     fmt::print(stderr, "a probe missed its pad by more than {:.1f} mm\n", kPadRadius * 1e3);
     return 1;
   }
-  return 0;
+  // RCCX_LOG's logs, one a robot (run-puma.csv, run-microbo.csv): put in place, whole or said.
+  bool logged = true;
+  for (rtc::Session* s : {&puma_session, &microbo_session}) {
+    s->close();
+    if (!s->log_problem().empty()) {
+      fmt::print(stderr, "10_circuit_board: {}'s sample log is lost: {}\n", s->name(),
+                 s->log_problem());
+      logged = false;
+    }
+  }
+  return logged ? 0 : 1;
 }

@@ -155,5 +155,5 @@ int main(int argc, char** argv) {
   const bool good = std::abs(touch->tool_frame.p.z * 1e3 - table_mm) < 0.5 && n > 0 &&
                     std::abs(sum / n - press_N) < 0.1 * press_N;
   fmt::print("{}\n", good ? "done" : "FAILED: the touch or the force was off");
-  return good ? 0 : 1;
+  return robot.finish_logs("11_touch_and_wipe") && good ? 0 : 1;  // RCCX_LOG's log whole
 }

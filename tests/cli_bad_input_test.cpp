@@ -185,6 +185,12 @@ TEST_F(BadInput, ControlPrograms) {
       {"", "cell-load --robots 2 --robot microbo", 2, "puma560 or puma260", ""},
       {"", "cell-load --robots 2 --spacing 0.5", 2, "--spacing", ""},
       {"", "cell-load --robots 3 --seconds 0.3", 0, "cycle compute over 30", ""},
+      // A log that cannot be written (a full disk: /dev/full) is lost: the run fails (exit 1).
+      {"", "report --seconds 0.2 --log /dev/full", 1, "the sample log is lost", ""},
+      {"RCCX_LOG=/dev/full", "report --seconds 0.2", 1, "the sample log is lost", ""},
+      {"", "jointtest --log /dev/full < /dev/null", 1, "the sample log is lost", ""},
+      {"RCCX_LOG=/dev/full", "jointtest < /dev/null", 1, "the sample log is lost", ""},
+      {"RCCX_LOG=/dev/full", "teach --db DIR/t.db < /dev/null", 1, "the sample log is lost", ""},
   });
 }
 
@@ -238,6 +244,36 @@ TEST_F(BadInput, EmptyValues) {
       {"", "marsh --push ''", 2, "--push: \"\" is empty", ""},
       {"", "cell-load --robot ''", 2, "--robot: \"\" is empty", ""},
   });
+}
+
+// One log a robot of a cell, named by its name in the cell: three robots of one model, three
+// files, each with its own header and rows.
+TEST_F(BadInput, ACellLogsOneFileARobotNamedByItsName) {
+  const std::string command = fmt::format(
+      "timeout -k 5 60 env RCCX_LOG={} {} cell-load --robots 3 "
+      "--period 10ms --seconds 0.3",
+      path("run.csv"), RCCX_CLI);
+  const CommandRun r = run(command);
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  std::vector<std::string> names;
+  for (const auto& e : fs::directory_iterator(dir_)) {
+    const std::string f = e.path().filename().string();
+    if (f.starts_with("run")) names.push_back(f);
+  }
+  ASSERT_EQ(names.size(), 3U) << "three robots, three logs";
+  std::vector<std::string> headers;
+  for (const std::string& f : names) {
+    std::ifstream in(dir_ / f);
+    std::string header;
+    std::getline(in, header);
+    const std::string name = f.substr(4, f.size() - 8);  // run-NAME.csv
+    EXPECT_NE(header.find(" name=" + name + " "), std::string::npos) << f << ": " << header;
+    EXPECT_NE(header.find("robot=puma560 "), std::string::npos) << header;
+    int rows = 0;
+    for (std::string line; std::getline(in, line);) ++rows;
+    // The column line and a row a 10 ms sample (and the few samples of the other robots' close).
+    EXPECT_NEAR(rows, 1 + 30, 3) << f;
+  }
 }
 
 // A log is written through a symbolic link (the link stays) and into a named pipe (never

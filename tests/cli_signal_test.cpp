@@ -150,6 +150,7 @@ class Signals : public ::testing::Test {
     std::istringstream in(text);
     std::string line;
     std::getline(in, line);
+    if (line.starts_with("# rccx-log")) std::getline(in, line);  // the header line, then columns
     const auto fields = std::count(line.begin(), line.end(), ',');
     std::size_t rows = 0;
     while (std::getline(in, line)) {

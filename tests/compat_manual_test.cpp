@@ -436,6 +436,18 @@ TEST_F(CompatManual, SetconfMovesThePumaIntoTheAskedConfiguration) {
   EXPECT_NE(message().find("no configuration letter 'x'"), std::string::npos) << message();
 }
 
+// A log that cannot be written (a full disk: /dev/full) makes rccl_close() fail with RTC_E_LOG,
+// so that a program that checks only rccl_close(), as the thesis's do, exits with an error.
+TEST_F(CompatManual, ALostLogMakesRcclCloseFail) {
+  ::setenv("RCCX_LOG", "/dev/full", 1);
+  open_parked();
+  EXPECT_EQ(rccl_close(0), RTC_E_LOG);
+  EXPECT_NE(message().find("rccl_close: the sample log is lost"), std::string::npos) << message();
+  ::unsetenv("RCCX_LOG");
+  open_parked();
+  EXPECT_EQ(rccl_close(0), RTC_OK) << message();
+}
+
 TEST_F(CompatManual, TeachTakesAStoredTransformFromTheDatabase) {
   const std::string db = ::testing::TempDir() + "rccx_teach_" + std::to_string(::getpid()) + ".db";
   std::filesystem::remove(db);

@@ -184,6 +184,27 @@ TEST_F(CompatRtc, ReleasePrintsItsArgumentThenMess) {
   EXPECT_FALSE(rccx::compat::rtc_session_open());
 }
 
+// A log that cannot be written (a full disk: /dev/full) makes rtc_close and release, which
+// close the session, return RTC_E_LOG: a program that checks them knows its log is lost.
+TEST_F(CompatRtc, ALostLogMakesRtcCloseAndReleaseFail) {
+  setenv("RCCX_LOG", "/dev/full", 1);
+  ASSERT_EQ(control(fn(ramp_fn1), nullptr), RTC_OK);
+  ASSERT_EQ(rtc_wait(100.), RTC_OK);
+  EXPECT_EQ(rtc_close(0), RTC_E_LOG);
+  EXPECT_EQ(rtc_error, RTC_E_LOG);
+  EXPECT_NE(std::string(rtc_error_message()).find("rtc_close: the sample log is lost"),
+            std::string::npos)
+      << rtc_error_message();
+  EXPECT_STREQ(rtc_error_name(RTC_E_LOG), "RTC_E_LOG");
+  ASSERT_EQ(control(fn(ramp_fn1), nullptr), RTC_OK);
+  ASSERT_EQ(rtc_wait(100.), RTC_OK);
+  EXPECT_EQ(release(nullptr), RTC_E_LOG);
+  unsetenv("RCCX_LOG");
+  ASSERT_EQ(control(fn(ramp_fn1), nullptr), RTC_OK);  // no log: nothing to lose
+  ASSERT_EQ(rtc_wait(100.), RTC_OK);
+  EXPECT_EQ(rtc_close(0), RTC_OK);
+}
+
 TEST_F(CompatRtc, CallsOutOfOrderAreRefused) {
   EXPECT_EQ(release("x"), RTC_E_SEQUENCE);  // no control
   EXPECT_EQ(rtc_error, RTC_E_SEQUENCE);

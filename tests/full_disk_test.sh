@@ -75,6 +75,10 @@ cases() {  # FULL_DIR MODE
     --seconds 20 --every 20 && intact "$full/env.csv" "OLD" "RCCX_LOG" "$mode" && pass "RCCX_LOG ($mode)"
 
   rm -f "$full"/*
+  expect "a cell's RCCX_LOG to a full disk" 1 "$full" "$mode" env RCCX_LOG="$full/cell.csv" "$rccx" \
+    cell-load --robots 3 --seconds 0.3 && pass "a cell's RCCX_LOG, one file a robot ($mode)"
+
+  rm -f "$full"/*
   expect "db import onto a full disk" 1 "$full" "$mode" "$rccx" db --db "$full/full.db" import "$work/big.json" &&
     pass "db import ($mode)"
   rm -f "$full"/*

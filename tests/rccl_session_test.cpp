@@ -72,7 +72,8 @@ struct LogRow {
 std::vector<LogRow> read_log(const std::filesystem::path& file, std::size_t dof) {
   std::ifstream in(file);
   std::string line;
-  std::getline(in, line);  // header
+  std::getline(in, line);                                      // the header line
+  if (line.starts_with("# rccx-log")) std::getline(in, line);  // then the columns
   std::vector<LogRow> rows;
   while (std::getline(in, line)) {
     std::stringstream ss(line);

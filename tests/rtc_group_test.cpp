@@ -1,5 +1,6 @@
 // Several robots on one clock (rtc::SessionGroup): each sampled at the ticks of its multiple,
 // its own control and termination, a fixed number of threads whatever their number.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <dirent.h>
@@ -9,6 +10,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -209,11 +211,77 @@ TEST(SessionGroup, EachRobotHasItsOwnEnvironmentLog) {
     std::ifstream in(file);
     ASSERT_TRUE(in.good()) << file;
     std::string line;
-    int n = -1;  // the header
+    int n = -2;  // the header line and the column line
     while (std::getline(in, line)) ++n;
     EXPECT_NEAR(n, rows, 1) << file;
     std::filesystem::remove(file);
   }
+}
+
+namespace {
+
+/// The lines of a log: the header line, the column line, then the rows.
+std::vector<std::string> lines_of(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  return lines;
+}
+
+/// Column `k` (0: t) of a CSV row.
+double column(const std::string& row, std::size_t k) {
+  std::size_t pos = 0;
+  for (std::size_t i = 0; i < k; ++i) pos = row.find(',', pos) + 1;
+  return std::stod(row.substr(pos));
+}
+
+}  // namespace
+
+TEST(SessionGroup, TwoRobotsOfOneModelLogTwoFilesEachWithItsOwnRows) {
+  const std::filesystem::path dir = ::testing::TempDir();
+  const std::string base = (dir / "twins.csv").string();
+  Arms a(3, "puma560");
+  ::setenv("RCCX_LOG", base.c_str(), 1);
+  {
+    rtc::SessionGroup group(clock_of(10ms));
+    rtc::Session& left = group.add(*a.drivers[0], 1, "left");
+    rtc::Session& right = group.add(*a.drivers[1], 2, "right");
+    rtc::Session& third = group.add(*a.drivers[2]);  // no name: its model's
+    EXPECT_THROW(group.add(*a.drivers[2], 1, "left"), rtc::SessionError) << "a name twice";
+    ::unsetenv("RCCX_LOG");
+    EXPECT_EQ(third.name(), "puma560");
+    group.start();
+    double q2 = 0.0;
+    left.control(
+        [&q2](rtc::Control& c) {  // only the left arm's joint 2 moves: 1 mrad a sample
+          if (q2 == 0.0) q2 = c.how().joint[1].range;
+          c.chg().posvel(1, q2 += 0.001);
+        },
+        {});
+    right.control({}, {});
+    third.control({}, {});
+    group.wait_for(200ms);
+  }
+  std::map<std::string, std::vector<std::string>> logs;
+  for (const char* name : {"left", "right", "puma560"}) {
+    const auto file = dir / fmt::format("twins-{}.csv", name);
+    logs[name] = lines_of(file);
+    ASSERT_GT(logs[name].size(), 4U) << file;
+    const auto header = rtc::LogHeader::parse(logs[name][0]);
+    ASSERT_TRUE(header) << logs[name][0];
+    EXPECT_EQ(header->robot, "puma560");
+    EXPECT_EQ(header->name, name) << "each file's header names its robot";
+    std::filesystem::remove(file);
+  }
+  EXPECT_FALSE(std::filesystem::exists(base)) << "no file for the group as a whole";
+  EXPECT_EQ(rtc::LogHeader::parse(logs["right"][0])->period_ns, 20'000'000);
+  // Every 10 ms sample of the left arm, every other one of the right: each file its own rows.
+  EXPECT_NEAR(static_cast<double>(logs["left"].size() - 2), 20, 1);
+  EXPECT_NEAR(static_cast<double>(logs["right"].size() - 2), 10, 1);
+  const auto& l = logs["left"];
+  const auto& r = logs["right"];
+  EXPECT_GT(column(l.back(), 3) - column(l[2], 3), 0.015) << "the left arm's joint 2 moved";
+  EXPECT_NEAR(column(r.back(), 3), column(r[2], 3), 1e-9) << "the right arm's did not";
 }
 
 TEST(SessionGroup, MisuseIsRefusedWithAReason) {

@@ -1,5 +1,6 @@
 // RTC sessions in simulated time (and a few in real time): the pipeline of thesis figure 4.7,
 // limit checks per checking mode, faults, the watchdog, release and control again, Ctrl-C.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <atomic>
@@ -684,9 +685,13 @@ TEST(RtcCodes, EveryCodeHasANameAndAMeaning) {
 
 namespace {
 
-std::vector<std::vector<double>> read_csv(const std::string& path, std::string& header) {
+/// The rows of a log; `header` gets its column line, `first` its first line (the header line).
+std::vector<std::vector<double>> read_csv(const std::string& path, std::string& header,
+                                          std::string* first = nullptr) {
   std::ifstream in(path);
   std::getline(in, header);
+  if (first != nullptr) *first = header;
+  if (header.starts_with("#")) std::getline(in, header);
   std::vector<std::vector<double>> rows;
   std::string line;
   while (std::getline(in, line)) {
@@ -707,7 +712,7 @@ TEST(RtcLog, EveryControlledSampleIsARowWithTheCommandedToolPose) {
   std::uint64_t samples = 0;
   double setpoint = 0;  // range value of joint 2
   {
-    rtc::SampleLog log(path, r.model);
+    rtc::SampleLog log(path, r.model, rtc::LogHeader::of(r.model, "arm", 10ms, true));
     r.session.set_log(&log);
     r.session.control(
         [&](rtc::Control& c) {
@@ -723,8 +728,12 @@ TEST(RtcLog, EveryControlledSampleIsARowWithTheCommandedToolPose) {
     r.session.set_log(nullptr);
     EXPECT_EQ(log.rows_dropped(), 0U);
   }  // the log is written out and closed here
-  std::string header;
-  const auto rows = read_csv(path, header);
+  std::string header, first;
+  const auto rows = read_csv(path, header, &first);
+  const std::string start = fmt::format(
+      "# rccx-log 1 robot=puma560 kinematics={} name=arm period_ns=10000000 clock=simulated rccx=",
+      rtc::kinematics_fingerprint(r.model));
+  EXPECT_TRUE(first.starts_with(start) && first.size() > start.size()) << first;
   EXPECT_EQ(header, "t,seg,q1,q2,q3,q4,q5,q6,qm1,qm2,qm3,qm4,qm5,qm6,x,y,z,ax,ay,az");
   ASSERT_EQ(rows.size(), samples);
   const auto kinematics = kin::make_kinematics(r.model);
@@ -748,6 +757,28 @@ TEST(RtcLog, EveryControlledSampleIsARowWithTheCommandedToolPose) {
   EXPECT_NEAR(rows.back()[3] - rows.front()[3], 0.001 * static_cast<double>(rows.size() - 1), 1e-9)
       << "joint 2 was commanded upward";
   if (!HasFailure()) std::remove(path.c_str());
+}
+
+TEST(RtcLog, TheHeaderLineReadsBackAsWritten) {
+  const kin::RobotModel puma = kin::builtin_robot("puma560");
+  rtc::LogHeader h = rtc::LogHeader::of(puma, "left arm 100%", 7ms, false);
+  const std::string line = h.line();
+  EXPECT_EQ(line.find("name=left%20arm%20100%25 "), line.find("name=")) << line;
+  const auto back = rtc::LogHeader::parse(line.substr(0, line.size() - 1));
+  ASSERT_TRUE(back);
+  EXPECT_EQ(back->robot, "puma560");
+  EXPECT_EQ(back->name, "left arm 100%");
+  EXPECT_EQ(back->period_ns, 7'000'000);
+  EXPECT_FALSE(back->simulated);
+  EXPECT_EQ(back->kinematics, rtc::kinematics_fingerprint(puma));
+  EXPECT_FALSE(back->rccx.empty());
+  // Another geometry under the same name has another fingerprint.
+  kin::RobotModel other = puma;
+  other.joints[1].dh.a_m += 0.001;
+  EXPECT_NE(rtc::kinematics_fingerprint(other), back->kinematics);
+  EXPECT_FALSE(rtc::LogHeader::parse("t,seg,q1"));
+  EXPECT_THROW(rtc::LogHeader::parse("# rccx-log 1 robot=puma560 name=x"), rtc::LogError)
+      << "a header without kinematics, period and clock";
 }
 
 TEST(RtcLog, TheEnvironmentNamesALogForAnySession) {

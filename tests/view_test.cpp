@@ -18,6 +18,7 @@
 #include <thread>
 
 #include "rccx/cell/cell.hpp"
+#include "rccx/io/file.hpp"
 #include "rccx/kinematics/kinematics.hpp"
 #include "rccx/rccl/manipulator.hpp"
 #include "rccx/rtc/simulated_robot.hpp"
@@ -458,6 +459,77 @@ TEST(ViewCli, BadInputExitsTwoWithWhatToDo) {
   r = test::rccx_run(fmt::format("view --robot microbo --port {} --seconds 1", taken.port()));
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.out.find("is in use"), std::string::npos) << r.out;
+  std::filesystem::remove_all(dir);
+}
+
+TEST(RunLog, TheHeaderNamesTheRobotItIsDrawnAs) {
+  const kin::RobotModel puma = kin::builtin_robot("puma560");
+  const std::string header =
+      rtc::LogHeader::of(puma, "left", std::chrono::milliseconds(10), true).line();
+  const view::RunLog headed = view::parse_run_log(header + kGoodLog, "run.csv");
+  ASSERT_TRUE(headed.header);
+  EXPECT_EQ(headed.header->name, "left");
+  EXPECT_EQ(headed.rows.size(), 2U) << "the header line is no row";
+  EXPECT_EQ(view::log_robot(headed, nullptr, "").name, "puma560") << "drawn as its own robot";
+  EXPECT_EQ(view::log_robot(headed, &puma, "--robot puma560").name, "puma560");
+  const kin::RobotModel microbo = kin::builtin_robot("microbo");
+  kin::RobotModel bent = puma;  // a robot file that says it is the PUMA, with another link
+  bent.joints[2].dh.a_m += 0.01;
+  for (const kin::RobotModel* other : {&microbo, static_cast<const kin::RobotModel*>(&bent)}) {
+    try {
+      (void)view::log_robot(headed, other, "--robot-file x.json");
+      ADD_FAILURE() << "a log of the PUMA drawn as " << other->name;
+    } catch (const view::RunLogError& e) {
+      const std::string m = e.what();
+      EXPECT_NE(m.find("robot puma560"), std::string::npos) << m;
+      EXPECT_NE(m.find("--robot-file x.json"), std::string::npos) << m;
+    }
+  }
+  // An old log, before headers: only as the robot named for it.
+  const view::RunLog old = view::parse_run_log(kGoodLog, "old.csv");
+  EXPECT_FALSE(old.header);
+  EXPECT_THROW((void)view::log_robot(old, nullptr, ""), view::RunLogError);
+  EXPECT_EQ(view::log_robot(old, &microbo, "--robot microbo").name, "microbo");
+  // A header that is not whole is refused with its line.
+  try {
+    (void)view::parse_run_log(std::string("# rccx-log 1 robot=puma560\n") + kGoodLog, "h.csv");
+    ADD_FAILURE() << "a header without its kinematics accepted";
+  } catch (const view::RunLogError& e) {
+    EXPECT_NE(std::string(e.what()).find("h.csv:1: the header line has no valid kinematics="),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+TEST(ViewCli, PlotAndReplayDrawALogAsItsOwnRobotAndRefuseAnother) {
+  const auto dir = std::filesystem::temp_directory_path() / "rccx_view_cli_robot_test";
+  std::filesystem::create_directories(dir);
+  const auto run = dir / "run.csv";
+  record_puma_run(run);
+  const auto svg = (dir / "out.svg").string();
+  auto r = test::rccx_run(fmt::format("plot {} -o {}", run.string(), svg));
+  EXPECT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_NE(r.out.find("robot puma560 (puma560)"), std::string::npos) << r.out;
+  std::filesystem::remove(svg);
+  for (const std::string& command :
+       {fmt::format("plot {} --robot microbo -o {}", run.string(), svg),
+        fmt::format("view --log {} --robot microbo --port 0 --seconds 1", run.string())}) {
+    r = test::rccx_run(command);
+    EXPECT_EQ(r.exit_code, 2) << command << "\n" << r.out;
+    EXPECT_NE(r.out.find("is a log of robot puma560"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("not of --robot microbo"), std::string::npos) << r.out;
+  }
+  EXPECT_FALSE(std::filesystem::exists(svg)) << "a refused plot wrote its file";
+  r = test::rccx_run(fmt::format("view --log {} --port 0 --seconds 0.5", run.string()));
+  EXPECT_EQ(r.exit_code, 0) << r.out;
+  // The same log without its header line (as rccx wrote before headers): --robot is needed.
+  std::string text = io::read_file(run);
+  io::write_file_atomically(dir / "old.csv", text.substr(text.find('\n') + 1));
+  r = test::rccx_run(fmt::format("plot {}/old.csv -o {}", dir.string(), svg));
+  EXPECT_EQ(r.exit_code, 2) << r.out;
+  EXPECT_NE(r.out.find("no header line naming its robot"), std::string::npos) << r.out;
+  r = test::rccx_run(fmt::format("plot {}/old.csv --robot puma560 -o {}", dir.string(), svg));
+  EXPECT_EQ(r.exit_code, 0) << r.out;
   std::filesystem::remove_all(dir);
 }
 

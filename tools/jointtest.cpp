@@ -310,6 +310,8 @@ int Console::end_session(int read_error) {
     status_ = kFailure;
   }
   if (read_error != 0) failed(fmt::format("reading stdin: {}", std::strerror(read_error)));
+  std::fflush(stdout);
+  status_ = finish_logs(r_, status_);  // a lost log makes the run a failure
   if (stopped()) {
     fmt::print("stopped by a signal: control released, the arm holds\n");
     std::fflush(stdout);

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cctype>
 #include <filesystem>
 #include <memory>
@@ -20,13 +21,13 @@ namespace {
 
 struct PlotArgs {
   RobotChoice robot{"microbo"};
+  bool robot_given = false;  ///< --robot or --robot-file: then it must be the log's own
   std::string log;
   std::string out;
   std::string title;
 };
 
 int run_plot(const PlotArgs& a) {
-  const kin::RobotModel model = a.robot.model();
   const std::filesystem::path out(a.out);
   std::string ext = out.extension().string();
   for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
@@ -46,8 +47,12 @@ int run_plot(const PlotArgs& a) {
 #endif
   view::RunLog log;
   std::string svg;
+  kin::RobotModel model;
+  double worst_m = 0.0;
   try {
     log = view::load_run_log(a.log);
+    model = robot_of_log(log, a.robot, a.robot_given);
+    for (double e : view::path_errors_m(log, model)) worst_m = std::max(worst_m, e);
     svg = view::plot_svg(
         log, model, a.title.empty() ? std::filesystem::path(a.log).filename().string() : a.title);
   } catch (const view::RunLogError& e) {
@@ -60,8 +65,11 @@ int run_plot(const PlotArgs& a) {
   file.write(svg);
 #endif
   file.commit();
-  fmt::print("{}: {} samples, {:.2f} s -> {}\n", a.log, log.rows.size(),
-             log.rows.back().t_s - log.rows.front().t_s, a.out);
+  fmt::print(
+      "{}: robot {} ({}), {} samples, {:.2f} s, worst path error {:.3f} mm (measured tool from "
+      "the commanded path, every sample) -> {}\n",
+      a.log, log.header ? log.header->name : model.name, model.name, log.rows.size(),
+      log.rows.back().t_s - log.rows.front().t_s, worst_m * 1e3, a.out);
   return kOk;
 }
 
@@ -83,7 +91,14 @@ void add_plot_command(CLI::App& app, int& exit_code) {
       ->check(not_empty());
   add_robot_options(*cmd, args->robot);
   cmd->add_option("--title", args->title, "The heading (default: the log's file name)");
-  cmd->callback([args, &exit_code] { guarded(exit_code, [&] { return run_plot(*args); }); });
+  cmd->footer(
+      "The log's header names its robot: it is drawn as that robot. --robot / --robot-file are "
+      "needed only for a log without a header (rccx before 0.1.0's headers) and are refused "
+      "(exit 2) when they name another robot than the header.");
+  cmd->callback([args, cmd, &exit_code] {
+    args->robot_given = robot_given(*cmd);
+    guarded(exit_code, [&] { return run_plot(*args); });
+  });
 }
 
 }  // namespace rccx::tools

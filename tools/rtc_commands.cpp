@@ -59,8 +59,7 @@ int report_termination(const rtc::Termination& t) {
 /// The end of every control program: the session closed, the logs in place. A log that is not
 /// complete (a full disk, rows dropped) makes the run a failure; a stop signal gives 128 + it.
 int finish(SimulatedRobot& r, int code) {
-  const std::string problem = r.finish();
-  if (!problem.empty() && code == kOk) code = kFailure;
+  code = finish_logs(r, code);
   if (io::stop_count() > 0) code = io::stop_exit_code();
   return code;
 }

@@ -51,6 +51,11 @@ rtc::SimulatedRobot SimulatedRobot::make(const RtcArgs& a) {
   }
 }
 
+int finish_logs(rtc::SimulatedRobot& robot, int code) {
+  if (robot.finish_logs("error")) return code;
+  return code == kOk ? kFailure : code;
+}
+
 void print_positions(const kin::RobotModel& m, const rtc::How& h) {
   fmt::print("t {:8.3f} s ", h.time_s);
   for (std::size_t i = 0; i < h.dof; ++i) {

@@ -49,6 +49,11 @@ inline const char* unit(const kin::Joint& j) {
   return revolute(j) ? "deg" : "mm";
 }
 
+/// Closes `robot`'s session and puts its logs (--log's, RCCX_LOG's) in place. A log that is lost
+/// (a write that failed: a full disk, an I/O error; rows dropped) is said on stderr and turns
+/// `code` kOk into kFailure: the run did not leave what was asked of it. Returns the code.
+int finish_logs(rtc::SimulatedRobot& robot, int code);
+
 /// One line: the time and every joint's position.
 void print_positions(const kin::RobotModel& m, const rtc::How& h);
 /// A table: power, hand, outputs, and every joint's position, range, speed and calibration.

@@ -14,6 +14,7 @@
 #include "rccx/math/units.hpp"
 #include "rccx/rccl/teach.hpp"
 #include "rccx/rtc/simulated_robot.hpp"
+#include "rtc_robot.hpp"
 
 namespace rccx::tools {
 namespace {
@@ -71,7 +72,7 @@ int run_teach(const TeachArgs& a) {
                  t.failed_commands == 1 ? "" : "s");
       return kFailure;
     }
-    return kOk;
+    return finish_logs(robot, kOk);  // RCCX_LOG's log: a lost one makes the run a failure
   } catch (const rccl::DatabaseError& e) {
     io::eprint("rccx teach: {}\n", e.what());
     return kFailure;

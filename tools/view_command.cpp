@@ -1,5 +1,7 @@
 #include "view_command.hpp"
 
+#include "plot_command.hpp"
+
 #include <fmt/format.h>
 
 #include <chrono>
@@ -24,6 +26,7 @@ namespace {
 
 struct ViewArgs {
   RobotChoice robot{"microbo"};
+  bool robot_given = false;  ///< --robot or --robot-file: with --log, it must be the log's own
   std::string cell;
   std::string log;
   std::string address = "127.0.0.1";
@@ -78,13 +81,13 @@ view::ServeOptions serve_options(const ViewArgs& a) {
 }
 
 int run_replay(const ViewArgs& a) {
-  const kin::RobotModel model = a.robot.model();
   view::RunLog log;
   try {
     log = view::load_run_log(a.log);
   } catch (const view::RunLogError& e) {
     throw BadArgument{fmt::format("--log: {}", e.what())};
   }
+  const kin::RobotModel model = robot_of_log(log, a.robot, a.robot_given);
   std::unique_ptr<view::Server> server;
   try {
     server = view::serve_replay(model, std::move(log), static_cast<std::uint16_t>(a.port),
@@ -213,7 +216,8 @@ void add_view_command(CLI::App& app, int& exit_code) {
       cmd->add_option("--cell", args->cell, "A cell file (cells/*.json): every robot of it")
           ->check(CLI::ExistingFile);
   auto* log = cmd->add_option("--log", args->log,
-                              "Replay this run (a CSV written by --log / RCCX_LOG) of --robot")
+                              "Replay this run (a CSV written by --log / RCCX_LOG) as the robot "
+                              "its header names (--robot only for a log without a header)")
                   ->check(CLI::ExistingFile);
   cell->excludes(log);
   cmd->add_option("--port", args->port, "TCP port (0: any free port)")
@@ -231,7 +235,10 @@ void add_view_command(CLI::App& app, int& exit_code) {
   cmd->add_flag("--fast", args->fast,
                 "Run simulated time as fast as the machine goes (default: at the clock's pace); "
                 "with RCCX_LOG=FILE, a quick way to record a run");
-  cmd->callback([args, &exit_code] { guarded(exit_code, [&] { return run_view(*args); }); });
+  cmd->callback([args, cmd, &exit_code] {
+    args->robot_given = robot_given(*cmd);
+    guarded(exit_code, [&] { return run_view(*args); });
+  });
 }
 
 }  // namespace rccx::tools

@@ -176,7 +176,7 @@ Cell::Cell(CellModel model, CellOptions options)
     auto r = std::make_unique<Robot>();
     r->name = cr.name;
     r->hardware = rtc::make_simulated_hardware(cr.model, true, options_.ideal_servo);
-    r->session = &group_->add(*r->hardware.driver, static_cast<int>(cr.period_multiple));
+    r->session = &group_->add(*r->hardware.driver, static_cast<int>(cr.period_multiple), cr.name);
     r->manipulator = std::make_unique<rccl::Manipulator>(*r->session);
     r->manipulator->generator().set_robot_name(cr.name);
     r->ledger.set_robot(cr.name);

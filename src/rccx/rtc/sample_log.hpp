@@ -1,4 +1,6 @@
-// A CSV record of a control session, one row a sample (issue 5's log format):
+// A CSV record of a control session, one row a sample (issue 5's log format), after a header
+// line that says whose it is (issue 24, LogHeader below):
+//   # rccx-log 1 robot=puma560 kinematics=5c1e0f2a9b3d4e67 name=puma period_ns=10000000 ...
 //   t,seg,q1..qN,qm1..qmN,x,y,z,ax,ay,az
 // time (s), motion segment index, commanded joints, measured joints (rad or m), and the
 // commanded tool position (m) and approach vector computed from the commanded joints by the
@@ -14,14 +16,16 @@
 
 #include <atomic>
 #include <boost/lockfree/spsc_queue.hpp>
+#include <chrono>
 #include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <stdexcept>
+#include <string>
+#include <string_view>
 #include <thread>
 #include <vector>
-
-#include <string>
 
 #include "rccx/io/file.hpp"
 #include "rccx/kinematics/kinematics.hpp"
@@ -39,6 +43,35 @@ class LogError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
 };
+
+/// Whose a log is: its first line, before the column line, so that a reader (rccx plot, rccx view
+/// --log) draws it as its own robot and refuses another:
+///   # rccx-log 1 robot=puma560 kinematics=5c1e0f2a9b3d4e67 name=left period_ns=10000000
+///     clock=simulated rccx=0.1.0                                  (one line)
+/// `1` is the format's version; then key=value words, in this order (a reader ignores keys it
+/// does not know). A value has no space: a space is written %20, a % %25.
+struct LogHeader {
+  std::string robot;           ///< the robot file's "name" (a shipped robot's: `rccx kin robots`)
+  std::string kinematics;      ///< kinematics_fingerprint() of the robot, 16 hex digits
+  std::string name;            ///< the robot's name in its cell (its model's name when alone)
+  std::int64_t period_ns = 0;  ///< the robot's sample period, ns
+  bool simulated = true;       ///< clock=simulated or clock=realtime
+  std::string rccx;            ///< the version of rccx that wrote it
+
+  /// The header of `model`'s log, named `name` (empty: the model's name), the running rccx.
+  static LogHeader of(const kin::RobotModel& model, std::string_view name,
+                      std::chrono::nanoseconds period, bool simulated);
+  /// The line, with its newline.
+  [[nodiscard]] std::string line() const;
+  /// The header of a line that starts "# rccx-log", else nullopt. Throws LogError for such a
+  /// line that is not a whole header (says what is missing or wrong).
+  static std::optional<LogHeader> parse(std::string_view line);
+};
+
+/// 16 hex digits that tell one robot's geometry from another's (a 64-bit FNV-1a hash of each
+/// joint's type and DH parameters): a robot file that shares a shipped robot's name but not its
+/// geometry has another fingerprint.
+std::string kinematics_fingerprint(const kin::RobotModel& model);
 
 struct LogRow {
   double t_s = 0.0;
@@ -61,14 +94,15 @@ class SampleTap {
 
 class SampleLog {
  public:
-  /// Starts the log of `file` (written when closed) with its header; throws LogError saying
-  /// why it cannot (a directory, a missing directory, no permission).
-  SampleLog(const std::filesystem::path& file, const kin::RobotModel& model);
+  /// Starts the log of `file` (written when closed) with `header` and the column line; throws
+  /// LogError saying why it cannot (a directory, a missing directory, no permission).
+  SampleLog(const std::filesystem::path& file, const kin::RobotModel& model,
+            const LogHeader& header);
   /// The log the environment asks for (RCCX_LOG=FILE), or nullptr; its errors name RCCX_LOG.
-  static std::unique_ptr<SampleLog> from_environment(const kin::RobotModel& model);
-  /// The same for one robot of several: RCCX_LOG=cell.csv gives cell<suffix>.csv.
+  /// `suffix` is for one robot of several: RCCX_LOG=cell.csv gives cell<suffix>.csv.
   static std::unique_ptr<SampleLog> from_environment(const kin::RobotModel& model,
-                                                     std::string_view suffix);
+                                                     const LogHeader& header,
+                                                     std::string_view suffix = {});
   /// Writes what is queued and puts the file in place. Empty when the log is complete, else
   /// what went wrong (rows dropped, a write that failed: the target is then left as it was).
   /// Only the first call does anything.

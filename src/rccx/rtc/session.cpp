@@ -21,28 +21,28 @@ using detail::monotonic_ns;
 
 Session::Session(Driver& driver, SessionOptions options)
     : driver_(driver), clock_(std::make_shared<SampleClock>(options)), owns_clock_(true) {
-  open_channel(1, {});
+  open_channel(1, {}, {});
   clock_->add(*channel_);
   clock_->start();
 }
 
 Session::Session(Driver& driver, std::shared_ptr<SampleClock> clock, int multiple,
-                 const std::string& log_suffix)
+                 const std::string& name)
     : driver_(driver), clock_(std::move(clock)) {
-  open_channel(multiple, log_suffix);
+  open_channel(multiple, name, "-" + name);
 }
 
-void Session::open_channel(int multiple, const std::string& log_suffix) {
+void Session::open_channel(int multiple, const std::string& name, const std::string& log_suffix) {
   if (driver_.model().dof() == 0 || driver_.model().dof() > kMaxJoints) {
     throw SessionError(fmt::format("robot {} has {} joints; RTC serves 1 to {}",
                                    driver_.model().name, driver_.model().dof(), kMaxJoints));
   }
-  check_period(std::chrono::nanoseconds(clock_->period_ns() * multiple));
-  if (log_suffix.empty()) {
-    environment_log_ = SampleLog::from_environment(driver_.model());  // LogError names RCCX_LOG
-  } else {
-    environment_log_ = SampleLog::from_environment(driver_.model(), log_suffix);
-  }
+  name_ = name.empty() ? driver_.model().name : name;
+  const std::chrono::nanoseconds period(clock_->period_ns() * multiple);
+  check_period(period);
+  const LogHeader header = LogHeader::of(driver_.model(), name_, period, clock_->simulated());
+  // LogError names RCCX_LOG.
+  environment_log_ = SampleLog::from_environment(driver_.model(), header, log_suffix);
   channel_ = std::make_unique<RobotChannel>(driver_, *clock_, multiple, clock_->size(),
                                             environment_log_.get());
 }
@@ -127,17 +127,34 @@ SessionGroup::~SessionGroup() {
   sessions_.clear();  // their logs close after the tasks have stopped
 }
 
-Session& SessionGroup::add(Driver& driver, int multiple) {
+Session& SessionGroup::add(Driver& driver, int multiple, std::string_view name) {
   if (clock_->running()) throw SessionError("add every robot before start()");
   if (multiple < 1 || multiple > 1000) {
     throw SessionError(fmt::format("robot {}: a period multiple of {}; give 1 to 1000",
                                    driver.model().name, multiple));
   }
   auto s =
-      std::unique_ptr<Session>(new Session(driver, clock_, multiple, "-" + driver.model().name));
+      std::unique_ptr<Session>(new Session(driver, clock_, multiple, unique_name(driver, name)));
   clock_->add(*s->channel_);
   sessions_.push_back(std::move(s));
   return *sessions_.back();
+}
+
+std::string SessionGroup::unique_name(const Driver& driver, std::string_view name) const {
+  const std::string base(name.empty() ? std::string_view(driver.model().name) : name);
+  const auto taken = [this](const std::string& n) {
+    return std::any_of(sessions_.begin(), sessions_.end(),
+                       [&n](const auto& s) { return s->name() == n; });
+  };
+  if (!name.empty() && taken(base)) {
+    throw SessionError(
+        fmt::format("a robot named \"{}\" is in the group already; give each "
+                    "robot its own name",
+                    base));
+  }
+  std::string unique = base;
+  for (int k = 2; taken(unique); ++k) unique = fmt::format("{}-{}", base, k);
+  return unique;
 }
 
 void SessionGroup::set_cycle_hook(std::function<void(std::uint32_t tick)> hook) {

@@ -39,6 +39,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <thread>
 #include <vector>
 
@@ -185,9 +186,13 @@ class Session {
   void set_period(std::chrono::nanoseconds period);
   [[nodiscard]] ClockKind clock() const noexcept;
   [[nodiscard]] Driver& driver() noexcept { return driver_; }
+  /// The robot's name: its model's alone, in a group the name add() gave it. What its log's
+  /// header and, in a group, its RCCX_LOG file are named by.
+  [[nodiscard]] const std::string& name() const noexcept { return name_; }
   /// Records every controlled sample to `log` (commanded and measured joints, the commanded
   /// tool pose); nullptr stops. Only while not in control. Without a call, a session logs to
-  /// the file named by the environment variable RCCX_LOG, if any.
+  /// the file named by the environment variable RCCX_LOG, if any (a robot of a group: that
+  /// name with "-<name()>" before the extension).
   void set_log(SampleLog* log);
   /// Calls `tap` every controlled sample from the communication task (the view's tap, see
   /// SampleTap); nullptr stops. Any time, from the planning level: a tap set while in control
@@ -206,13 +211,14 @@ class Session {
  private:
   friend class SessionGroup;
 
-  /// A robot of a group: sampled every `multiple`-th tick of `clock`.
+  /// A robot of a group, `name`d: sampled every `multiple`-th tick of `clock`.
   Session(Driver& driver, std::shared_ptr<SampleClock> clock, int multiple,
-          const std::string& log_suffix);
-  void open_channel(int multiple, const std::string& log_suffix);
+          const std::string& name);
+  void open_channel(int multiple, const std::string& name, const std::string& log_suffix);
   void check_period(std::chrono::nanoseconds p) const;
 
   Driver& driver_;
+  std::string name_;
   std::shared_ptr<SampleClock> clock_;
   bool owns_clock_ = false;
   std::unique_ptr<SampleLog> environment_log_;  ///< RCCX_LOG's, when set
@@ -243,10 +249,12 @@ class SessionGroup {
   SessionGroup(const SessionGroup&) = delete;
   SessionGroup& operator=(const SessionGroup&) = delete;
 
-  /// Adds a robot sampled every `multiple`-th tick (1 .. 1000). Only before start(). Throws
-  /// SessionError for a period its driver cannot serve. With RCCX_LOG=FILE set, its log is
-  /// FILE with "-<robot name>" before the extension.
-  Session& add(Driver& driver, int multiple = 1);
+  /// Adds a robot sampled every `multiple`-th tick (1 .. 1000), called `name` (a cell's name
+  /// for it; empty: its model's name, numbered -2, -3 ... when the group has one of that name
+  /// already). Only before start(). Throws SessionError for a period its driver cannot serve
+  /// or a `name` given twice. With RCCX_LOG=FILE set, its log is FILE with "-<name>" before
+  /// the extension (RCCX_LOG=run.csv: run-left.csv, run-right.csv), one file a robot.
+  Session& add(Driver& driver, int multiple = 1, std::string_view name = {});
   /// Starts the communication and control tasks; robots are read every tick from now on.
   void start();
   [[nodiscard]] std::size_t size() const noexcept { return sessions_.size(); }
@@ -275,6 +283,8 @@ class SessionGroup {
   void set_robot_hook(std::function<void(std::size_t robot, std::uint32_t tick)> hook);
 
  private:
+  std::string unique_name(const Driver& driver, std::string_view name) const;
+
   std::shared_ptr<SampleClock> clock_;
   std::vector<std::unique_ptr<Session>> sessions_;
 };

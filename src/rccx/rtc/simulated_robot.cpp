@@ -1,6 +1,7 @@
 #include "rccx/rtc/simulated_robot.hpp"
 
 #include "rccx/hw/rcu.hpp"
+#include "rccx/io/console.hpp"
 #include "rccx/rtc/microbo_driver.hpp"
 #include "rccx/rtc/servo_driver.hpp"
 
@@ -61,7 +62,9 @@ SimulatedRobot::SimulatedRobot(kin::RobotModel m, const SimulatedRobotOptions& o
   so.clock = options.clock;
   session = std::make_unique<Session>(*driver, so);
   if (!options.log.empty()) {
-    log = std::make_unique<SampleLog>(options.log, model);
+    log = std::make_unique<SampleLog>(
+        options.log, model,
+        LogHeader::of(model, {}, session->period(), options.clock == ClockKind::simulated));
     session->set_log(log.get());
   }
 }
@@ -77,6 +80,13 @@ std::string SimulatedRobot::finish() {
     if (std::string p = log->close(); !p.empty()) problem += (problem.empty() ? "" : "; ") + p;
   }
   return problem;
+}
+
+bool SimulatedRobot::finish_logs(std::string_view program) {
+  const std::string lost = finish();
+  if (lost.empty()) return true;
+  io::eprint("{}: the sample log is lost: {}\n", program, lost);
+  return false;
 }
 
 void SimulatedRobot::push(std::size_t joint, double effort) {

@@ -10,12 +10,15 @@
 //   arm.waitfor(arm.move(arm.park()).end());         // simulated time runs while waiting
 //   robot.push(1, 20.0);                             // a hand pushes joint 2, N m
 //   const std::string problem = robot.finish();      // closes; run.csv in place, "" if whole
+//   return robot.finish_logs("demo") ? 0 : 1;         // or: a lost log said, the exit code 1
 #pragma once
 
 #include <chrono>
 #include <filesystem>
 #include <memory>
 #include <stdexcept>
+#include <string>
+#include <string_view>
 
 #include "rccx/hw/rcu.hpp"
 #include "rccx/hw/simulated_arm.hpp"
@@ -81,6 +84,10 @@ struct SimulatedRobot {
   /// Closes the session and puts the logs (--log's and RCCX_LOG's) in place: empty when they
   /// are complete, else what went wrong (already said on stderr).
   std::string finish();
+  /// finish(), a lost log said on stderr as "<program>: the sample log is lost: <why>" (a full
+  /// disk, an I/O error, rows dropped). True when every log is whole (or there is none): what a
+  /// program's exit code checks, `return robot.finish_logs("washer") && ok ? 0 : 1;`.
+  bool finish_logs(std::string_view program);
 };
 
 }  // namespace rccx::rtc

@@ -139,15 +139,46 @@ void panel(std::string& svg, const Box& b, const std::string& title, const std::
   svg += "</g>\n";
 }
 
-}  // namespace
-
-std::string plot_svg(const RunLog& log, const kin::RobotModel& model, const std::string& title) {
+/// The log's joints must be the robot's.
+void check_joints(const RunLog& log, const kin::RobotModel& model) {
   if (log.dof != model.dof()) {
     throw RunLogError(
         fmt::format("the log has {} joints, robot {} has {}: give the robot it was "
                     "recorded with (--robot)",
                     log.dof, model.name, model.dof()));
   }
+}
+
+}  // namespace
+
+std::vector<double> path_errors_m(const RunLog& log, const kin::RobotModel& model) {
+  check_joints(log, model);
+  const auto kinematics = kin::make_kinematics(model);
+  const std::size_t n = log.rows.size();
+  std::vector<math::Vec3> pc(n), pm(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    pc[i] = {log.rows[i].p[0], log.rows[i].p[1], log.rows[i].p[2]};
+    pm[i] = kinematics->forward(log.rows[i].measured).p;
+  }
+  std::vector<double> errors(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    // The nearest point of the commanded polyline around the sample: a lag along the path is
+    // not an error of the path.
+    double e = (pm[i] - pc[i]).norm();
+    const std::size_t from = i > 600 ? i - 600 : 0, to = std::min(n - 1, i + 50);
+    for (std::size_t j = from; j < to; ++j) {
+      const math::Vec3 d = pc[j + 1] - pc[j];
+      const double len2 = math::dot(d, d);
+      const double s = len2 > 0 ? std::clamp(math::dot(pm[i] - pc[j], d) / len2, 0.0, 1.0) : 0.0;
+      e = std::min(e, (pc[j] + d * s - pm[i]).norm());
+    }
+    errors[i] = e;
+  }
+  return errors;
+}
+
+std::string plot_svg(const RunLog& log, const kin::RobotModel& model, const std::string& title) {
+  const std::vector<double> errors_m = path_errors_m(log, model);  // checks the joints
   const auto kinematics = kin::make_kinematics(model);
   const std::size_t n = log.rows.size();
   std::vector<double> t(n);
@@ -210,17 +241,7 @@ std::string plot_svg(const RunLog& log, const kin::RobotModel& model, const std:
     const double dt = i == 0 ? 0.0 : log.rows[i].t_s - log.rows[i - 1].t_s;
     speed_c.y.push_back(i == 0 ? 0.0 : (pc[i] - pc[i - 1]).norm() / dt * 1e3);
     speed_m.y.push_back(i == 0 ? 0.0 : (pm[i] - pm[i - 1]).norm() / dt * 1e3);
-    // How far the measured tool is from the commanded path (the nearest point of the commanded
-    // polyline around it: a lag along the path is not an error of the path).
-    double e = (pm[i] - pc[i]).norm();
-    const std::size_t from = i > 600 ? i - 600 : 0, to = std::min(n - 1, i + 50);
-    for (std::size_t j = from; j < to; ++j) {
-      const math::Vec3 d = pc[j + 1] - pc[j];
-      const double len2 = math::dot(d, d);
-      const double s = len2 > 0 ? std::clamp(math::dot(pm[i] - pc[j], d) / len2, 0.0, 1.0) : 0.0;
-      e = std::min(e, (pc[j] + d * s - pm[i]).norm());
-    }
-    e *= 1e3;
+    const double e = errors_m[i] * 1e3;
     error.y.push_back(e);
     worst = std::max(worst, e);
   }
@@ -234,7 +255,7 @@ std::string plot_svg(const RunLog& log, const kin::RobotModel& model, const std:
       "stroke:#e4e4e4}}</style>\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n"
       "<text x=\"{2}\" y=\"24\" class=\"title\" style=\"font-size:17px\">{3}</text>\n"
       "<text x=\"{2}\" y=\"42\" class=\"tick\">{4}: {5} samples, {6:.2f} s; worst path error "
-      "{7:.3f} mm</text>\n",
+      "{7:.3f} mm (measured tool from the commanded path, every sample)</text>\n",
       W, H, W / 2, escape(title), escape(model.title.empty() ? model.name : model.title), n,
       t.back(), worst);
   const double top = 50, ph = (H - top) / 2, pw = W / 2;

@@ -8,11 +8,19 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "rccx/kinematics/robot_model.hpp"
 #include "rccx/view/run_log.hpp"
 
 namespace rccx::view {
+
+/// The path error of a run at each of its samples, m: how far the measured tool point is from
+/// the commanded path (the nearest point of the commanded tool's polyline from 600 samples
+/// before to 50 after: a lag along the path is not an error of the path). Every sample counts,
+/// corner blends and joint motions too: the largest is what `rccx plot` calls the "worst path
+/// error". RunLogError when the log's joints are not the robot's.
+std::vector<double> path_errors_m(const RunLog& log, const kin::RobotModel& model);
 
 /// The SVG document (about 1200 x 900 px). `title` heads it. RunLogError when the log's joints
 /// do not match the robot's.
