@@ -101,6 +101,11 @@ TEST_F(BadInput, Kinematics) {
       {"", "kin fk --robot puma560 0 0 0 0 0 1e200", 2, "out of range", ""},
       {"", "kin fk --robot puma560 0 0", 2, "6 joints, got 2", ""},
       {"", "kin fk --robot pmua560 0 0 0 0 0 0", 2, "known robots", ""},
+      // A pose: finite, within 100 m (a larger one is a typo, not "unreachable"), units named.
+      {"", "kin ik --T 1,0,0,1e308,0,1,0,0,0,0,1,0", 2, "from -100 to 100", ""},
+      {"", "kin ik --xyz 1e308,0,0 --rpy 0,0,0", 2, "--xyz (x): \"1e308\" is out of range", ""},
+      {"", "kin ik --xyz 0,0,0 --rpy 0,0,inf", 2, "--rpy (yaw): \"inf\" is not an angle", ""},
+      {"", "kin ik --xyz 0,0,0 --rpy ''", 2, "empty", ""},
       {"", "kin fk --robot-file DIR/huge.json 0", 2, "not valid JSON", ""},
       {"", "kin fk --robot-file DIR/long.json 0", 2, "at most 100", ""},
       {"", "kin fk --robot-file DIR/unknown_key.json 0", 2, "unknown key \"upper_mm\"", ""},

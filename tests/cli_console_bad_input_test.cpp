@@ -130,6 +130,31 @@ TEST(CliConsole, TeachRefusesBadLinesMovesNothingAndExits1) {
   }
 }
 
+TEST(CliConsole, TeachCreatesTheDatabaseAtTheFirstSaveOnly) {
+  const TempFile db;
+  namespace fs = std::filesystem;
+  // Nothing saved (a refused save included): no file, here or as ./rccx.db.
+  check({"teach", "", 1, {"save: the name"}, {}},
+        rccx_with_input("teach --db " + db.path(), "m 1 10\nsave A/B\ne\n"));
+  EXPECT_FALSE(fs::exists(db.path()));
+  const fs::path cwd = fs::temp_directory_path() / fmt::format("rccx_teach_cwd_{}", ::getpid());
+  fs::create_directories(cwd);
+  const std::string in_cwd =
+      "cd " + cwd.string() + " && env -u RCCX_DB " + RCCX_CLI + " teach < /dev/null 2>&1";
+  EXPECT_EQ(rccx::test::run_shell(in_cwd).exit_code, 0);
+  EXPECT_TRUE(fs::is_empty(cwd)) << "teach without save left a file in " << cwd;
+  fs::remove_all(cwd);
+  // The first save creates it; a second session adds to it.
+  check({"teach", "", 0, {"saved P for microbo in"}, {"error"}},
+        rccx_with_input("teach --db " + db.path(), "m 1 10\nsave P\ne\n"));
+  EXPECT_TRUE(fs::exists(db.path()));
+  check({"teach", "", 0, {"saved Q for microbo"}, {"error"}},
+        rccx_with_input("teach --db " + db.path(), "save Q\ne\n"));
+  const rccx::test::ShellRun list = rccx_with_input("db --db " + db.path() + " list", "");
+  EXPECT_NE(list.out.find("microbo P:"), std::string::npos) << list.out;
+  EXPECT_NE(list.out.find("microbo Q:"), std::string::npos) << list.out;
+}
+
 TEST(CliConsole, JointtestRefusesBadLinesAndExits1) {
   const std::vector<Case> cases = {
       {"jointtest --robot puma560", "j 2.5\nx\nq\n", 1, {"its joints are 1 to 6"}, {"joint 2 ("}},

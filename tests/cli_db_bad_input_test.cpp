@@ -22,6 +22,8 @@
 #include <utility>
 #include <vector>
 
+#include "rccx/math/transform.hpp"
+#include "rccx/math/units.hpp"
 #include "rccx/rccl/position_db.hpp"
 #include "rccx/rccl/position_export.hpp"
 
@@ -188,7 +190,15 @@ TEST_F(CliDbBadInput, PutRefusesBadArgumentsBeforeTouchingTheDatabase) {
       {put + "1,0,0,1e400,0,1,0,0.1,0,0,1,0.2", 2, "too large"},
       {put + "1,0,0,,0,1,0,0.1,0,0,1,0.2", 2, "missing"},
       {put + "''", 2, "empty"},
-      {put + "1,0,0,0.3,0,1,0,0.1,0,0,2,0.2", 2, "rigid"},
+      {put + "1,0,0,0.3,0,1,0,0.1,0,0,2,0.2", 2, "not a rotation matrix"},
+      // Finite but absurd: within 100 m on each axis, so that mm and products stay finite.
+      {put + "1,0,0,1e308,0,1,0,0.1,0,0,1,0.2", 2, "out of range; give a number from -100 to 100"},
+      {put + "1,0,0,100.5,0,1,0,0.1,0,0,1,0.2", 2, "out of range"},
+      {"db --db {db} put --robot microbo P --xyz 1e308,0,0 --rpy 0,0,0", 2, "out of range"},
+      {"db --db {db} put --robot microbo P --xyz 0.3,0,0", 2, "--xyz requires --rpy"},
+      {"db --db {db} put --robot microbo P --rpy 0,0,1e400deg --xyz 0,0,0", 2, "too large"},
+      {"db --db {db} put --robot microbo P --xyz 0.3,0,0 --rpy 0,nan,0", 2, "not an angle"},
+      {"db --db {db} put --robot microbo P", 2, "give --T (12 numbers), or --xyz and --rpy"},
       {"db --db {db} put --robot microbo 'TWO WORDS' --T " + std::string(kT), 2, "not a name"},
       {"db --db {db} put --robot microbo " + std::string(33, 'N') + " --T " + kT, 2, "at most 32"},
       {"db --db {db} put --robot microbo '' --T " + std::string(kT), 2, "empty"},
@@ -206,8 +216,17 @@ TEST_F(CliDbBadInput, PutRefusesBadArgumentsBeforeTouchingTheDatabase) {
       {"db --db {dir} put --robot microbo P --T " + std::string(kT), 2, "is a directory"},
       // A misspelt robot is refused, with the known ones and how to declare a new one.
       {"db --db {db} put --robot pmua560 P --T " + std::string(kT), 2,
-       "\"pmua560\" is not a known robot (known: microbo, puma260, puma560, stanford); check "
-       "the spelling, or add --new-robot"},
+       "\"pmua560\" is not a known robot; did you mean puma560? (known: microbo, puma260, "
+       "puma560, stanford); check the spelling, or declare a new robot with --new-robot "
+       "pmua560"},
+      // --new-robot takes the robot's name, as import's does; the old switch is refused.
+      {"db --db {db} put --robot gantry P --new-robot --T " + std::string(kT), 2, "not expected"},
+      {"db --db {db} put --robot microbo P --xyz '' --rpy 0,0,0", 2, "empty"},
+      {"db --db {db} put --robot gantry --new-robot gantri P --T " + std::string(kT), 2,
+       "--new-robot \"gantri\" is not --robot \"gantry\""},
+      {"db --db {db} put --new-robot a --new-robot b P --T " + std::string(kT), 2,
+       "give --new-robot once"},
+      {"db --db {db} put --new-robot 'a b' P --T " + std::string(kT), 2, "not a name"},
       // A bad name does not create the file.
       {"db --db {db} put --robot microbo 'A B' --T " + std::string(kT), 2, "not a name", {}, true},
       {"db --db {db} put --robot pmua560 P --T " + std::string(kT),
@@ -216,18 +235,14 @@ TEST_F(CliDbBadInput, PutRefusesBadArgumentsBeforeTouchingTheDatabase) {
        {},
        true},
       // What may be stored is.
-      {"db --db {db} put --robot gantry P --new-robot --T " + std::string(kT),
-       0,
-       "",
-       {},
-       false,
-       false},
+      {"db --db {db} put --new-robot gantry P --T " + std::string(kT), 0, "", {}, false, false},
       {put + kT + " --note 'über dem Tisch' --config lun", 0, "", {}, false, false},
   });
   // gantry is now known, so a second put needs no --new-robot.
   const fs::path db = dir_ / "cell.db";
   EXPECT_EQ(
-      rccx_cli("db --db " + db.string() + " put --robot gantry P --new-robot --T " + kT).exit_code,
+      rccx_cli("db --db " + db.string() + " put --robot gantry --new-robot gantry P --T " + kT)
+          .exit_code,
       0);
   EXPECT_EQ(rccx_cli("db --db " + db.string() + " put --robot gantry Q --T " + kT).exit_code, 0);
 }
@@ -243,6 +258,108 @@ TEST_F(CliDbBadInput, ShowListRmRefuseBadNamesAndReportMissingFiles) {
       {"db --db {dir}/not-a-db list", 1, "is it an rccx database?",
        with_file("not-a-db", std::string(8192, 'x'))},
   });
+}
+
+TEST_F(CliDbBadInput, AnUnknownRobotIsRefusedNamingTheNearest) {
+  const auto stored_gantry = [](const fs::path&, const fs::path& db) {
+    rccl::StoredTransform t;
+    t.robot = "gantry";
+    t.name = "HOME";
+    rccl::PositionDb(db).put(t);
+    return std::shared_ptr<void>();
+  };
+  const std::string nearest = "did you mean puma560? (known: microbo, puma260, puma560, stanford)";
+  run_all({
+      {"db --db {db} list --robot pmua560", 2, nearest},
+      {"db --db {db} list --robot MICROBOO", 2, "did you mean microbo?"},
+      {"db --db {db} show --robot pmua560 KEEP", 2, nearest},
+      {"db --db {db} rm --robot pmua560 KEEP", 2, nearest},
+      {"db --db {db} export --robot pmua560", 2, nearest},
+      {"db --db {db} export --robot pmua560 {dir}/out.json", 2, nearest},
+      // A robot of the database is known, and is the nearest of a typo of it.
+      {"db --db {db} list --robot gantri", 2, "did you mean gantry?", stored_gantry},
+      {"db --db {db} list --robot gantry", 0, "gantry HOME:", stored_gantry},
+      // A shipped robot with nothing stored lists nothing, and that is no error.
+      {"db --db {db} list --robot puma260", 0, ""},
+  });
+  EXPECT_FALSE(fs::exists(dir_ / "out.json"));
+}
+
+TEST_F(CliDbBadInput, ACorruptStoredValueIsSaidNeverPrintedAsInf) {
+  // Rows another program (or an older rccx) wrote: a position of 1e308 m, an infinite one.
+  const auto bad_rows = [](const fs::path&, const fs::path& db) {
+    sqlite3* raw = nullptr;
+    sqlite3_open(db.c_str(), &raw);
+    sqlite3_exec(raw,
+                 "INSERT INTO transforms VALUES ('microbo', 'FAR', 1,0,0, 0,1,0, 0,0,1, "
+                 "1e308,0,0, 'm, rad', '', '', 5, 6);"
+                 "INSERT INTO transforms VALUES ('microbo', 'INF', 1,0,0, 0,1,0, 0,0,1, "
+                 "9e999,0,0, 'm, rad', '', '', 5, 6)",
+                 nullptr, nullptr, nullptr);
+    sqlite3_close(raw);
+    return std::shared_ptr<void>();
+  };
+  // (list is below: its good lines come before the error.)
+  for (const char* args : {"show --robot microbo FAR", "show --robot microbo INF", "export",
+                           "export {dir}/out.json"}) {
+    run_all({{std::string("db --db {db} ") + args, 1, "", bad_rows}});
+  }
+  const fs::path db = dir_ / "cell.db";
+  const CliRun show = rccx_cli("db --db " + db.string() + " show --robot microbo FAR");
+  EXPECT_NE(show.out.find("FAR of robot microbo: the stored value is corrupt (position (1e+308"),
+            std::string::npos)
+      << show.out;
+  const CliRun list = rccx_cli("db --db " + db.string() + " list");
+  EXPECT_EQ(list.exit_code, 1);
+  EXPECT_NE(list.out.find("microbo INF: the stored value is corrupt (not a rigid transform"),
+            std::string::npos)
+      << list.out;
+  EXPECT_NE(list.out.find("microbo KEEP: x 0.000"), std::string::npos) << list.out;
+  EXPECT_NE(list.out.find("2 stored values are corrupt"), std::string::npos) << list.out;
+  for (const CliRun& r : {show, list}) {
+    EXPECT_EQ(r.out.find("inf"), std::string::npos) << r.out;
+    EXPECT_EQ(r.out.find("nan"), std::string::npos) << r.out;
+  }
+  EXPECT_FALSE(fs::exists(dir_ / "out.json"));
+}
+
+TEST_F(CliDbBadInput, XyzAndRpyStoreWhatTheMatrixDoesAndShowNamesItsAngles) {
+  const fs::path db = dir_ / "cell.db";
+  const std::string put = "db --db " + db.string() + " put --robot microbo ";
+  // URDF's roll 10 deg about x, pitch 20 deg about y, yaw 30 deg about z.
+  const math::Transform T{
+      math::Rot3::from_urdf_rpy(math::deg_to_rad(10), math::deg_to_rad(20), math::deg_to_rad(30)),
+      {0.325, -0.15, 0.25}};
+  std::string rows;
+  for (double v : T.rows()) rows += fmt::format("{}{}", rows.empty() ? "" : ",", v);
+  ASSERT_EQ(rccx_cli(put + "BY_T --T " + rows).exit_code, 0);
+  ASSERT_EQ(rccx_cli(put + "BY_M --xyz 0.325m,-0.15,0.25 --rpy 10deg,20deg,30deg").exit_code, 0);
+  ASSERT_EQ(rccx_cli(put + "BY_MM --xyz 325mm,-150mm,250mm --rpy 0.17453292519943295rad,"
+                           "0.3490658503988659,0.5235987755982988")
+                .exit_code,
+            0);
+  const rccl::PositionDb d(db, rccl::PositionDb::Open::existing);
+  const math::Transform by_t = d.get("microbo", "BY_T")->value;
+  EXPECT_LT(math::max_abs_difference(by_t, T), 1e-15);
+  for (const char* name : {"BY_M", "BY_MM"}) {
+    EXPECT_LT(math::max_abs_difference(d.get("microbo", name)->value, by_t), 1e-15) << name;
+  }
+  // The angles printed are those typed, with their convention named; Paul's are the reverse.
+  const CliRun show = rccx_cli("db --db " + db.string() + " show --robot microbo BY_M");
+  ASSERT_EQ(show.exit_code, 0) << show.out;
+  for (const char* piece :
+       {"x 325.000 y -150.000 z 250.000 mm, URDF rpy (about fixed x, y, z) 10.000 20.000 30.000 "
+        "deg",
+        "Paul's RPY (RCCL, cell files: Rot(z, roll) Rot(y, pitch) Rot(x, yaw)): roll 30.000 "
+        "pitch 20.000 yaw 10.000 deg"}) {
+    EXPECT_NE(show.out.find(piece), std::string::npos) << piece << "\n" << show.out;
+  }
+  // The help says both forms and the convention.
+  const CliRun help = rccx_cli("db put --help");
+  for (const char* word :
+       {"--T", "--xyz", "--rpy", "URDF", "roll about x", "--new-robot NAME", "100 m"}) {
+    EXPECT_NE(help.out.find(word), std::string::npos) << word << "\n" << help.out;
+  }
 }
 
 TEST_F(CliDbBadInput, ALockedDatabaseIsBusyNotDamaged) {

@@ -19,6 +19,7 @@
 
 #include "rccx/hw/rcu.hpp"
 #include "rccx/kinematics/kinematics.hpp"
+#include "rccx/math/units.hpp"
 
 #include "shell_run.hpp"
 
@@ -95,6 +96,44 @@ TEST(Cli, InverseRoundTripsEveryConfiguration) {
   EXPECT_EQ(json::parse(near.out)["config"], "rdn");
 }
 
+TEST(Cli, KinDefaultsToTheMicroboAsEveryCommand) {
+  const CliRun fk = rccx_cli("kin fk 0 0 0.3 0 0 0 --json", false);
+  ASSERT_EQ(fk.exit_code, 0) << fk.out;
+  EXPECT_EQ(json::parse(fk.out)["robot"], "microbo");
+  const CliRun help = rccx_cli("kin ik --help");
+  EXPECT_NE(help.out.find("microbo"), std::string::npos) << help.out;
+}
+
+TEST(Cli, InverseTakesXyzAndUrdfRpyWithUnitsAsTheSamePoseAsT) {
+  // The PUMA's pose of the published zero, turned: URDF's roll 30 deg about x, pitch -20 deg
+  // about y, yaw 50 deg about z.
+  const math::Transform T{
+      math::Rot3::from_urdf_rpy(math::deg_to_rad(30), math::deg_to_rad(-20), math::deg_to_rad(50)),
+      {0.45, -0.15005, 0.3}};
+  const CliRun by_t =
+      rccx_cli("kin ik --robot puma560 --all --json --T " + pose_argument(T), false);
+  ASSERT_EQ(by_t.exit_code, 0) << by_t.out;
+  for (const char* xyz_rpy : {"--xyz 0.45,-0.15005,0.3 --rpy 30deg,-20deg,50deg",
+                              "--xyz 450mm,-150.05mm,300mm --rpy 0.5235987755982988rad,"
+                              "-0.3490658503988659,0.8726646259971648"}) {
+    const CliRun by_xyz =
+        rccx_cli(std::string("kin ik --robot puma560 --all --json ") + xyz_rpy, false);
+    ASSERT_EQ(by_xyz.exit_code, 0) << xyz_rpy << "\n" << by_xyz.out;
+    const json a = json::parse(by_t.out)["solutions"], b = json::parse(by_xyz.out)["solutions"];
+    ASSERT_EQ(a.size(), b.size()) << xyz_rpy;
+    for (std::size_t s = 0; s < a.size(); ++s) {
+      EXPECT_EQ(a[s]["config"], b[s]["config"]);
+      for (std::size_t i = 0; i < 6; ++i) {
+        EXPECT_NEAR(a[s]["q"][i].get<double>(), b[s]["q"][i].get<double>(), 1e-9) << xyz_rpy;
+      }
+    }
+  }
+  const CliRun help = rccx_cli("kin ik --help");
+  for (const char* word : {"--xyz", "--rpy", "URDF", "roll about x", "bare number is rad"}) {
+    EXPECT_NE(help.out.find(word), std::string::npos) << word << "\n" << help.out;
+  }
+}
+
 TEST(Cli, UnreachableExitsThreeWithAReason) {
   const CliRun run = rccx_cli("kin ik --robot puma560 --T 1,0,0,2,0,1,0,0,0,0,1,0");
   EXPECT_EQ(run.exit_code, 3);
@@ -115,7 +154,19 @@ TEST(Cli, BadArgumentsExitTwoAndSayWhatToDo) {
       {"kin ik --robot puma560 --T 1,0,0,0.5,0,1,0,0,0,0,1,0 --config lun --near 0,0,0,0,0,0",
        "excludes"},
       {"kin ik --robot puma560 --T 1,0,0,0.5,0,1,0,0,0,0,1,0 --near 0,0", "6 joints, got 2"},
-      {"kin ik --robot puma560", "--T is required"},
+      {"kin ik --robot puma560", "give --T (12 numbers), or --xyz and --rpy"},
+      {"kin ik --robot puma560 --T 1,0,0,500,0,1,0,0,0,0,1,0", "from -100 to 100"},
+      {"kin ik --xyz 0.3,0.1,0.2", "--xyz requires --rpy"},
+      {"kin ik --rpy 0,0,0", "--rpy requires --xyz"},
+      {"kin ik --T 1,0,0,0.5,0,1,0,0,0,0,1,0 --xyz 0.3,0.1,0.2 --rpy 0,0,0", "excludes"},
+      {"kin ik --xyz 0.3,0.1 --rpy 0,0,0", "--xyz: 2 values given, 3 needed"},
+      {"kin ik --xyz 30cm,0.1,0.2 --rpy 0,0,0", "--xyz (x): \"30cm\" is not a length"},
+      {"kin ik --xyz 0.3,0.1,200 --rpy 0,0,0", "--xyz (z): \"200\" is out of range"},
+      {"kin ik --xyz 0.3,0.1,inf --rpy 0,0,0", "is not a length"},
+      {"kin ik --xyz 0.3,0.1,1e400mm --rpy 0,0,0", "too large"},
+      // A bare angle is rad: 180 is more than a turn, so a forgotten deg is refused.
+      {"kin ik --xyz 0.3,0.1,0.2 --rpy 180,0,0", "--rpy (roll): \"180\" is out of range"},
+      {"kin ik --xyz 0.3,0.1,0.2 --rpy 0,0,90grad", "--rpy (yaw): \"90grad\" is not an angle"},
       {"kin fk --robot-file /nonexistent.json 0", "File does not exist"},
       {"kin", "needs a command: fk, ik, robots"},
   };

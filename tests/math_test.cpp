@@ -128,6 +128,31 @@ TEST_F(RandomFrames, RpyRoundTripsAndMatchesPaulsDefinition) {
   EXPECT_LT(max_diff(Rot3::from_rpy(rpy[0], rpy[1], rpy[2]), locked), 1e-12);
 }
 
+TEST_F(RandomFrames, UrdfRpyIsAboutFixedXThenYThenZAndRoundTrips) {
+  for (int i = 0; i < 1000; ++i) {
+    const double roll = angle(rng), pitch = angle(rng) / 2.0, yaw = angle(rng);
+    const Rot3 R = Rot3::from_urdf_rpy(roll, pitch, yaw);
+    const Eigen::Matrix3d expected = (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
+                                      Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
+                                      Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
+                                         .matrix();
+    EXPECT_LT((to_eigen(R) - expected).cwiseAbs().maxCoeff(), 1e-15);
+    const auto rpy = R.to_urdf_rpy();
+    EXPECT_NEAR(rpy[0], roll, 1e-9);
+    EXPECT_NEAR(rpy[1], pitch, 1e-9);
+    EXPECT_NEAR(rpy[2], yaw, 1e-9);
+  }
+  // The tool pointing down (a turn about x): URDF's roll, Paul's yaw.
+  const Rot3 down = Rot3::from_urdf_rpy(180_deg, 0, 0);
+  EXPECT_LT(max_diff(down, Rot3::rot_x(180_deg)), 1e-15);
+  EXPECT_NEAR(std::abs(down.to_rpy()[2]), 180_deg, 1e-12);
+  // Gimbal lock: yaw takes the rotation about z and the rotation it gives back is the same.
+  const Rot3 locked = Rot3::from_urdf_rpy(0.3, -90_deg, 0.4);
+  const auto rpy = locked.to_urdf_rpy();
+  EXPECT_EQ(rpy[0], 0.0);
+  EXPECT_LT(max_diff(Rot3::from_urdf_rpy(rpy[0], rpy[1], rpy[2]), locked), 1e-12);
+}
+
 TEST_F(RandomFrames, ZyzRoundTrips) {
   for (int i = 0; i < 1000; ++i) {
     const double phi = angle(rng), theta = std::abs(angle(rng)), psi = angle(rng);

@@ -102,7 +102,16 @@ TEST(PositionDb, BadNamesAndNonRigidTransformsAreRefusedAndChangeNothing) {
   StoredTransform bad = sample("microbo", "NAN", 0.3);
   bad.value.p.x = NAN;
   EXPECT_NE(error_of([&] { db.put(bad); }), "");
-  EXPECT_EQ(db.list().size(), 2u);  // KEEP and the 32-character one
+  // Finite but absurd: 1e308 m overflows in mm and in any product of transforms.
+  StoredTransform far = sample("microbo", "FAR", 0.3);
+  far.value.p.y = 1e308;
+  EXPECT_NE(error_of([&] { db.put(far); }).find("beyond 100 m"), std::string::npos);
+  far.value.p.y = -(rccl::kMaxPosition_m + 1e-9);
+  EXPECT_NE(error_of([&] { db.put(far); }).find("beyond"), std::string::npos);
+  far.value.p.y = -rccl::kMaxPosition_m;  // the bound itself is stored
+  EXPECT_NO_THROW(db.put(far));
+  EXPECT_EQ(PositionDb::value_problem(far.value), "");
+  EXPECT_EQ(db.list().size(), 3u);  // KEEP, the 32-character one and FAR at the bound
 }
 
 TEST(PositionDb, MissingForeignAndNewerFilesGiveClearErrors) {

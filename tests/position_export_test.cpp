@@ -97,6 +97,7 @@ TEST(PositionExport, EveryDepartureFromTheFormatIsRefusedByName) {
       {one("", "[1,0,0,0.1, 0,1,0,0.2, 0,0,1,null]"), "element 11 is a null"},
       {one("", "null"), "key \"T_rows_m\": a null"},
       {one("", "[1,0,0,0.1, 0,1,0,0.2, 0,0,2,0.3]"), "rigid"},
+      {one("", "[1,0,0,0.1, 0,1,0,1e308, 0,0,1,0.3]"), "beyond 100 m"},
       {one(R"(, "colour": "red")"), "transforms[0] (\"PICK\"), key \"colour\": not a key"},
       {one(R"(, "note": "a\u0000b")"), "control character"},
       {one(R"(, "note": "a\nb")"), "control character"},

@@ -5,15 +5,20 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <set>
+#include <string_view>
 #include <system_error>
+#include <vector>
 
+#include "pose_options.hpp"
 #include "rccx/io/console.hpp"
 #include "rccx/io/file.hpp"
 #include "rccx/io/parse.hpp"
@@ -34,12 +39,11 @@ struct DbArgs {
   std::string robot;
   std::string name;
   std::string pattern = "*";
-  std::string T;  // 12 comma-separated numbers, parsed strictly (CLI11 would take inf and nan)
+  PoseArgs pose;  // --T, or --xyz and --rpy, parsed strictly (CLI11 would take inf and nan)
   std::string configuration;
   std::string note;
   std::string path;                     // export / import file ("-": stdout / stdin)
-  bool new_robot = false;               // put: --robot may be a robot not known yet
-  std::vector<std::string> new_robots;  // import: robots the file may add
+  std::vector<std::string> new_robots;  // put, import: robots not known yet that may be added
   /// The options given as "" (refused: an empty name or path is a lost variable, not a choice).
   std::vector<CLI::Option*> not_empty;
 };
@@ -67,15 +71,46 @@ std::string shown_name(const std::string& name) {
   }
 }
 
+/// Why a row read back cannot be shown ("" when it can): one another program wrote, or an older
+/// rccx stored beyond today's bounds. Its numbers are not printed (no inf or nan).
+std::string corrupt(const rccl::StoredTransform& t) {
+  return PositionDb::value_problem(t.value);
+}
+
 std::string line(const rccl::StoredTransform& t) {
-  const auto rpy = t.value.R.to_rpy();
+  const std::string who = fmt::format("{} {}", shown_name(t.robot), shown_name(t.name));
+  if (const std::string problem = corrupt(t); !problem.empty()) {
+    return fmt::format(
+        "{}: the stored value is corrupt ({}); store it again with `rccx db put` "
+        "or remove it with `rccx db rm`\n",
+        who, problem);
+  }
+  // URDF's angles, as --rpy takes them: what is printed can be typed back.
+  const auto rpy = t.value.R.to_urdf_rpy();
   return fmt::format(
-      "{} {}: x {:.3f} y {:.3f} z {:.3f} mm, roll {:.3f} pitch {:.3f} yaw {:.3f} deg{}{}\n",
-      shown_name(t.robot), shown_name(t.name), t.value.p.x * 1e3, t.value.p.y * 1e3,
-      t.value.p.z * 1e3, math::rad_to_deg(rpy[0]), math::rad_to_deg(rpy[1]),
-      math::rad_to_deg(rpy[2]),
+      "{}: x {:.3f} y {:.3f} z {:.3f} mm, URDF rpy (about fixed x, y, z) {:.3f} {:.3f} {:.3f} "
+      "deg{}{}\n",
+      who, t.value.p.x * 1e3, t.value.p.y * 1e3, t.value.p.z * 1e3, math::rad_to_deg(rpy[0]),
+      math::rad_to_deg(rpy[1]), math::rad_to_deg(rpy[2]),
       t.configuration.empty() ? "" : ", configuration " + shown_text(t.configuration),
       t.note.empty() ? "" : " (" + shown_text(t.note) + ")");
+}
+
+/// `db show`: the line, the same rotation as Paul's angles (RCCL's and the cell files'), and JSON.
+std::string shown_transform(const rccl::StoredTransform& t, const std::string& file) {
+  if (const std::string problem = corrupt(t); !problem.empty()) {
+    throw rccl::DatabaseError(fmt::format(
+        "position database {}: {} of robot {}: the stored value is corrupt ({}); store it "
+        "again with `rccx db put` or remove it with `rccx db rm`",
+        file, shown_name(t.name), shown_name(t.robot), problem));
+  }
+  const auto paul = t.value.R.to_rpy();
+  return line(t) +
+         fmt::format(
+             "  Paul's RPY (RCCL, cell files: Rot(z, roll) Rot(y, pitch) Rot(x, yaw)): "
+             "roll {:.3f} pitch {:.3f} yaw {:.3f} deg\n",
+             math::rad_to_deg(paul[0]), math::rad_to_deg(paul[1]), math::rad_to_deg(paul[2])) +
+         rccl::position_json(t);
 }
 
 /// Writes `text` to standard output and flushes it; throws FileError when any of it was lost
@@ -152,14 +187,14 @@ std::string read_stdin() {
 }
 
 /// The database, opened when it exists (a missing file is not created here), with the robots
-/// a put or an import may use: the shipped ones, those already stored, and those declared new.
+/// known: the shipped ones, those already stored, and those declared new.
 struct Known {
   std::unique_ptr<PositionDb> db;
   std::set<std::string> robots;
 };
 
 Known known_robots(const std::string& file, std::chrono::milliseconds wait,
-                   const std::vector<std::string>& declared) {
+                   const std::vector<std::string>& declared = {}) {
   Known k;
   for (std::string& r : kin::builtin_robot_names()) k.robots.insert(std::move(r));
   k.robots.insert(declared.begin(), declared.end());
@@ -171,10 +206,175 @@ Known known_robots(const std::string& file, std::chrono::milliseconds wait,
   return k;
 }
 
+/// The database of `k`, opened now when it was missing (`mode` says whether to create it).
+PositionDb& opened(Known& k, const std::string& file, std::chrono::milliseconds wait,
+                   PositionDb::Open mode = PositionDb::Open::existing) {
+  if (!k.db) k.db = std::make_unique<PositionDb>(file, mode, wait);
+  return *k.db;
+}
+
 std::string joined(const std::set<std::string>& names) {
   std::string out;
   for (const std::string& n : names) out += fmt::format("{}{}", out.empty() ? "" : ", ", n);
   return out;
+}
+
+/// The edit distance of a and b, letters compared without case: how near a typo is to a name.
+std::size_t distance(std::string_view a, std::string_view b) {
+  const auto lower = [](char c) {
+    return static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  };
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diagonal = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t above = row[j];
+      const std::size_t change = lower(a[i - 1]) == lower(b[j - 1]) ? 0 : 1;
+      row[j] = std::min({above + 1, row[j - 1] + 1, diagonal + change});
+      diagonal = above;
+    }
+  }
+  return row[b.size()];
+}
+
+/// Throws BadArgument unless `robot` is known, naming the nearest known robot; `then` says what
+/// else the user may do. A misspelt robot must not read as "nothing stored".
+void require_known(const std::string& robot, const Known& k, std::string_view then) {
+  if (k.robots.count(robot) != 0) return;
+  const auto nearest = std::min_element(
+      k.robots.begin(), k.robots.end(),
+      [&](const auto& x, const auto& y) { return distance(robot, x) < distance(robot, y); });
+  throw BadArgument{
+      fmt::format("--robot: {} is not a known robot; did you mean {}? (known: {}); {}",
+                  io::quoted(robot), *nearest, joined(k.robots), then)};
+}
+
+constexpr const char* kCheckSpelling = "check the spelling";
+
+/// The robot a put stores for: --robot, or the one --new-robot declares.
+std::string robot_to_put(const DbArgs& a) {
+  if (a.new_robots.size() > 1) {
+    throw BadArgument{"--new-robot: a put stores for one robot; give --new-robot once"};
+  }
+  if (a.robot.empty() && a.new_robots.empty()) {
+    throw BadArgument{"--robot is required (or --new-robot NAME for a robot not known yet)"};
+  }
+  if (!a.robot.empty() && !a.new_robots.empty() && a.new_robots[0] != a.robot) {
+    throw BadArgument{fmt::format(
+        "--new-robot {} is not --robot {}; give the new robot's name once, as --new-robot NAME",
+        io::quoted(a.new_robots[0]), io::quoted(a.robot))};
+  }
+  return a.robot.empty() ? a.new_robots[0] : a.robot;
+}
+
+void db_list(const std::string& file, std::chrono::milliseconds wait, const DbArgs& a) {
+  if (a.pattern.empty()) {
+    throw BadArgument{"pattern: \"\" is empty; give a name or a glob such as * or P*"};
+  }
+  io::check_text(a.pattern, "pattern", kMaxPattern);
+  Known k = known_robots(file, wait);
+  if (!a.robot.empty()) require_known(a.robot, k, kCheckSpelling);
+  std::string out;
+  std::size_t bad = 0;
+  for (const auto& t : opened(k, file, wait).list(a.robot, a.pattern)) {
+    out += line(t);
+    bad += corrupt(t).empty() ? 0 : 1;
+  }
+  write_stdout(out);
+  if (bad > 0) {
+    throw rccl::DatabaseError(
+        fmt::format("position database {}: {} stored value{} corrupt (said "
+                    "above)",
+                    file, bad, bad == 1 ? " is" : "s are"));
+  }
+}
+
+BadArgument not_stored(const std::string& file, const DbArgs& a) {
+  return BadArgument{fmt::format("{} has no {} for robot {} (`rccx db list` shows what it has)",
+                                 file, a.name, a.robot)};
+}
+
+void db_show(const std::string& file, std::chrono::milliseconds wait, const DbArgs& a) {
+  Known k = known_robots(file, wait);
+  require_known(a.robot, k, kCheckSpelling);
+  const auto t = opened(k, file, wait).get(a.robot, a.name);
+  if (!t) throw not_stored(file, a);
+  write_stdout(shown_transform(*t, file));
+}
+
+void db_rm(const std::string& file, std::chrono::milliseconds wait, const DbArgs& a) {
+  Known k = known_robots(file, wait);
+  require_known(a.robot, k, kCheckSpelling);
+  if (!opened(k, file, wait).remove(a.robot, a.name)) throw not_stored(file, a);
+}
+
+void db_put(const std::string& file, std::chrono::milliseconds wait, const DbArgs& a) {
+  rccl::StoredTransform t;
+  t.robot = robot_to_put(a);
+  t.name = a.name;
+  t.value = pose_from(a.pose, rccl::kMaxPosition_m);
+  t.configuration = a.configuration;
+  t.note = a.note;
+  PositionDb::check(t);  // InvalidTransform: exit 2, before any file is made
+  Known k = known_robots(file, wait, a.new_robots);
+  require_known(
+      t.robot, k,
+      fmt::format("check the spelling, or declare a new robot with --new-robot {}", t.robot));
+  opened(k, file, wait, PositionDb::Open::create).put(t);
+}
+
+void db_export(const std::string& file, std::chrono::milliseconds wait, const DbArgs& a) {
+  std::error_code ec;
+  const bool to_stdout = a.path.empty() || a.path == "-";
+  if (!to_stdout && std::filesystem::is_directory(a.path, ec)) {
+    throw BadArgument{fmt::format(
+        "export: {} is a directory; name a file, or - for standard output", io::quoted(a.path))};
+  }
+  Known k = known_robots(file, wait);
+  if (!a.robot.empty()) require_known(a.robot, k, kCheckSpelling);
+  const std::vector<rccl::StoredTransform> all = opened(k, file, wait).list(a.robot);
+  for (const auto& t : all)
+    (void)shown_transform(t, file);  // a corrupt value: said, nothing exported
+  const std::string text = rccl::position_export_json(all);
+  if (to_stdout) {
+    write_stdout(text);
+  } else if (std::filesystem::exists(a.path, ec) && !std::filesystem::is_regular_file(a.path, ec)) {
+    write_device(a.path, text);  // /dev/stdout, a pipe: not to be replaced by a file
+  } else {
+    io::write_file_atomically(a.path, text);  // the old file, or the new one whole
+  }
+}
+
+void db_import(const std::string& file, std::chrono::milliseconds wait, const DbArgs& a) {
+  const bool from_stdin = a.path == "-";
+  std::string text;
+  try {
+    text = from_stdin ? read_stdin() : io::read_file(a.path, kMaxInput);
+  } catch (const io::FileError& e) {
+    throw BadArgument{fmt::format("{}; nothing imported", e.what())};
+  }
+  const std::vector<rccl::StoredTransform> all =
+      rccl::parse_position_export(text, from_stdin ? "standard input" : a.path);
+  Known k = known_robots(file, wait, a.new_robots);
+  std::set<std::string> unknown;
+  for (const auto& t : all) {
+    if (k.robots.count(t.robot) == 0) unknown.insert(t.robot);
+  }
+  if (!unknown.empty()) {
+    std::string names;
+    for (const std::string& n : unknown) {
+      names += fmt::format("{}{}", names.empty() ? "" : ", ", io::quoted(n));
+    }
+    throw BadArgument{fmt::format(
+        "{}: robot {} not known (known: {}); check the file, or declare each new robot with "
+        "--new-robot NAME; nothing imported",
+        from_stdin ? "standard input" : a.path, names, joined(k.robots))};
+  }
+  // All or nothing; a stop signal before the commit means nothing.
+  opened(k, file, wait, PositionDb::Open::create).put(all, [] { return io::stop_count() > 0; });
+  io::eprint("imported {} transforms into {}\n", all.size(), file);
 }
 
 int run_db(const std::string& what, const DbArgs& a) {
@@ -188,9 +388,8 @@ int run_db(const std::string& what, const DbArgs& a) {
   }
   const std::string file = database_file(a.file);
   // Every argument is checked before the database is opened: bad input creates no file.
-  if (!a.robot.empty() || what == "show" || what == "put" || what == "rm") {
-    check_robot(a.robot, "--robot");
-  }
+  if (!a.robot.empty() || what == "show" || what == "rm") check_robot(a.robot, "--robot");
+  for (const std::string& r : a.new_robots) check_robot(r, "--new-robot");
   if (what == "show" || what == "put" || what == "rm") check_transform_name(a.name);
   const auto wait = busy_timeout(a);
   std::error_code ec;
@@ -201,98 +400,12 @@ int run_db(const std::string& what, const DbArgs& a) {
         "position database {} is {}; name a database file with --db", io::quoted(file),
         type == std::filesystem::file_type::directory ? "a directory" : "not a regular file")};
   }
-
-  if (what == "list") {
-    if (a.pattern.empty()) {
-      throw BadArgument{"pattern: \"\" is empty; give a name or a glob such as * or P*"};
-    }
-    io::check_text(a.pattern, "pattern", kMaxPattern);
-    PositionDb db(file, PositionDb::Open::existing, wait);
-    std::string out;
-    for (const auto& t : db.list(a.robot, a.pattern)) out += line(t);
-    write_stdout(out);
-  } else if (what == "show") {
-    PositionDb db(file, PositionDb::Open::existing, wait);
-    const auto t = db.get(a.robot, a.name);
-    if (!t) {
-      throw BadArgument{fmt::format("{} has no {} for robot {} (`rccx db list` shows what it has)",
-                                    file, a.name, a.robot)};
-    }
-    write_stdout(line(*t) + rccl::position_json(*t));
-  } else if (what == "put") {
-    rccl::StoredTransform t;
-    t.robot = a.robot;
-    t.name = a.name;
-    const std::vector<double> v = io::parse_number_list(a.T, "--T", 12, {.unit = "m"});
-    std::array<double, 12> rows{};
-    std::copy(v.begin(), v.end(), rows.begin());
-    t.value = math::Transform::from_rows(rows);
-    t.configuration = a.configuration;
-    t.note = a.note;
-    PositionDb::check(t);  // InvalidTransform: exit 2, before any file is made
-    Known k =
-        known_robots(file, wait, a.new_robot ? std::vector{a.robot} : std::vector<std::string>{});
-    if (k.robots.count(a.robot) == 0) {
-      throw BadArgument{fmt::format(
-          "--robot: {} is not a known robot (known: {}); check the spelling, or add --new-robot "
-          "to store positions for a new robot",
-          io::quoted(a.robot), joined(k.robots))};
-    }
-    if (!k.db) k.db = std::make_unique<PositionDb>(file, PositionDb::Open::create, wait);
-    k.db->put(t);
-  } else if (what == "rm") {
-    PositionDb db(file, PositionDb::Open::existing, wait);
-    if (!db.remove(a.robot, a.name)) {
-      throw BadArgument{fmt::format("{} has no {} for robot {} (`rccx db list` shows what it has)",
-                                    file, a.name, a.robot)};
-    }
-  } else if (what == "export") {
-    const bool to_stdout = a.path.empty() || a.path == "-";
-    if (!to_stdout && std::filesystem::is_directory(a.path, ec)) {
-      throw BadArgument{fmt::format(
-          "export: {} is a directory; name a file, or - for standard output", io::quoted(a.path))};
-    }
-    PositionDb db(file, PositionDb::Open::existing, wait);
-    const std::string text = rccl::position_export_json(db.list(a.robot));
-    if (to_stdout) {
-      write_stdout(text);
-    } else if (std::filesystem::exists(a.path, ec) &&
-               !std::filesystem::is_regular_file(a.path, ec)) {
-      write_device(a.path, text);  // /dev/stdout, a pipe: not to be replaced by a file
-    } else {
-      io::write_file_atomically(a.path, text);  // the old file, or the new one whole
-    }
-  } else if (what == "import") {
-    for (const std::string& r : a.new_robots) check_robot(r, "--new-robot");
-    const bool from_stdin = a.path == "-";
-    std::string text;
-    try {
-      text = from_stdin ? read_stdin() : io::read_file(a.path, kMaxInput);
-    } catch (const io::FileError& e) {
-      throw BadArgument{fmt::format("{}; nothing imported", e.what())};
-    }
-    const std::vector<rccl::StoredTransform> all =
-        rccl::parse_position_export(text, from_stdin ? "standard input" : a.path);
-    Known k = known_robots(file, wait, a.new_robots);
-    std::set<std::string> unknown;
-    for (const auto& t : all) {
-      if (k.robots.count(t.robot) == 0) unknown.insert(t.robot);
-    }
-    if (!unknown.empty()) {
-      std::string names;
-      for (const std::string& n : unknown) {
-        names += fmt::format("{}{}", names.empty() ? "" : ", ", io::quoted(n));
-      }
-      throw BadArgument{fmt::format(
-          "{}: robot {} not known (known: {}); check the file, or declare each new robot with "
-          "--new-robot NAME; nothing imported",
-          from_stdin ? "standard input" : a.path, names, joined(k.robots))};
-    }
-    if (!k.db) k.db = std::make_unique<PositionDb>(file, PositionDb::Open::create, wait);
-    // All or nothing; a stop signal before the commit means nothing.
-    k.db->put(all, [] { return io::stop_count() > 0; });
-    io::eprint("imported {} transforms into {}\n", all.size(), file);
-  }
+  if (what == "list") db_list(file, wait, a);
+  if (what == "show") db_show(file, wait, a);
+  if (what == "rm") db_rm(file, wait, a);
+  if (what == "put") db_put(file, wait, a);
+  if (what == "export") db_export(file, wait, a);
+  if (what == "import") db_import(file, wait, a);
   return kOk;
 }
 
@@ -343,34 +456,46 @@ void add_db_command(CLI::App& app, int& exit_code) {
   add_duration_option(*db, "--wait", args->wait, std::chrono::nanoseconds(0), std::chrono::hours(1),
                       "How long to wait for another process writing the database");
   db->require_subcommand(1);
-  const auto robot_name = [&](CLI::App* c) {
-    not_empty(c->add_option("--robot", args->robot, "The robot the transform belongs to"))
-        ->required();
+  // --new-robot NAME, the same for put and import: one name a time (repeat it for several).
+  const auto new_robot = [&](CLI::App* c, const char* help) {
+    not_empty(c->add_option("--new-robot", args->new_robots, help))
+        ->type_name("NAME")
+        ->allow_extra_args(false);
+  };
+  const auto robot_name = [&](CLI::App* c, bool robot_required) {
+    CLI::Option* robot =
+        not_empty(c->add_option("--robot", args->robot, "The robot the transform belongs to"));
+    if (robot_required) robot->required();
     not_empty(c->add_option("name", args->name, "Transform name (1 to 32 letters, digits, _ - .)"))
         ->required();
   };
+  // --robot of list, show, rm and export: a robot neither shipped nor stored is refused (exit 2),
+  // naming the nearest known one, rather than listing nothing.
   CLI::App* list = db->add_subcommand("list", "Lists transforms (all robots unless --robot)");
   not_empty(list->add_option("--robot", args->robot, "Only this robot's"));
   not_empty(list->add_option("pattern", args->pattern, "Name pattern (glob: *, ?)"))
       ->capture_default_str();
-  CLI::App* show = db->add_subcommand("show", "Prints one transform (mm, deg, and as JSON)");
-  robot_name(show);
+  CLI::App* show = db->add_subcommand(
+      "show",
+      "Prints one transform: position in mm, rotation as URDF's roll-pitch-yaw (about the fixed "
+      "x, y, z axes, as --rpy takes it) and as Paul's (RCCL's: roll about z), in deg; then JSON "
+      "(m, rad)");
+  robot_name(show, true);
   CLI::App* put = db->add_subcommand(
       "put",
-      "Stores a transform (replacing one of that name). --robot must be a shipped robot "
-      "(microbo, puma560, puma260, stanford) or one the database already has; a new robot is "
-      "declared with --new-robot, so that a misspelt name is refused rather than stored.");
-  robot_name(put);
-  not_empty(put->add_option(
-                "--T", args->T,
-                "r11,r12,r13,px,r21,r22,r23,py,r31,r32,r33,pz (m): 12 comma-separated numbers"))
-      ->required();
+      "Stores a transform (replacing one of that name), given as --T or as --xyz and --rpy. "
+      "--robot must be a shipped robot (microbo, puma560, puma260, stanford) or one the database "
+      "already has; a new robot is declared with --new-robot NAME (as for import), so that a "
+      "misspelt name is refused rather than stored. The position is within 100 m of the origin "
+      "on each axis, the rotation orthonormal and right-handed.");
+  robot_name(put, false);
+  add_pose_options(*put, args->pose, "The transform");
   put->add_option("--config", args->configuration,
                   "The arm configuration it is for (up to 8 letters, e.g. lun)");
   put->add_option("--note", args->note, "A note (UTF-8, up to 1000 bytes, one line)");
-  put->add_flag("--new-robot", args->new_robot, "--robot is a new robot: store it all the same");
+  new_robot(put, "A robot not known yet to store for (then --robot may be left out)");
   CLI::App* rm = db->add_subcommand("rm", "Removes a transform");
-  robot_name(rm);
+  robot_name(rm, true);
   CLI::App* exp = db->add_subcommand(
       "export", "Writes every transform as JSON (a file is replaced whole or not at all)");
   not_empty(exp->add_option("--robot", args->robot, "Only this robot's"));
@@ -380,8 +505,7 @@ void add_db_command(CLI::App& app, int& exit_code) {
       "Reads a JSON export: all transforms or none. Its robots must be shipped robots or ones "
       "the database has; declare each new one with --new-robot NAME.");
   not_empty(imp->add_option("file", args->path, "Input file (- for standard input)"))->required();
-  not_empty(imp->add_option("--new-robot", args->new_robots,
-                            "A robot the file may add (repeat for several)"));
+  new_robot(imp, "A robot the file may add (repeat for several)");
   for (CLI::App* c : {list, show, put, rm, exp, imp}) {
     const std::string what = c->get_name();
     c->callback([args, what, &exit_code] { exit_code = run(what, *args); });

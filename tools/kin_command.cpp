@@ -10,10 +10,12 @@
 #include <string>
 #include <vector>
 
+#include "pose_options.hpp"
 #include "rccx/io/console.hpp"
 #include "rccx/io/parse.hpp"
 #include "rccx/kinematics/kinematics.hpp"
 #include "rccx/math/units.hpp"
+#include "rccx/rccl/position_db.hpp"
 
 namespace rccx::tools {
 
@@ -90,7 +92,7 @@ std::string format_transform(const math::Transform& T) {
 // ---- rccx kin fk ----
 
 struct FkArgs {
-  RobotChoice robot{"puma560"};
+  RobotChoice robot{"microbo"};  // the default of every rccx command
   std::vector<std::string> q;
   bool degrees = false;
   bool json = false;
@@ -118,8 +120,8 @@ int run_fk(const FkArgs& args) {
 // ---- rccx kin ik ----
 
 struct IkArgs {
-  RobotChoice robot{"puma560"};
-  std::string T;
+  RobotChoice robot{"microbo"};
+  PoseArgs pose;
   std::string config;
   std::string near;
   bool degrees = false;
@@ -127,31 +129,11 @@ struct IkArgs {
   bool json = false;
 };
 
-math::Transform pose_from(const std::string& text) {
-  const std::vector<double> values =
-      io::parse_number_list(text, "--T", 12, {-1e6, 1e6, "(rotation) or m (position)"});
-  std::array<double, 12> m{};
-  std::copy(values.begin(), values.end(), m.begin());
-  const math::Transform T = math::Transform::from_rows(m);
-  // RᵀR must be the identity: a pose with a sheared or scaled rotation has no joint solution.
-  const math::Rot3 RtR = T.R.transposed() * T.R;
-  double error = 0.0;
-  for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) error = std::max(error, std::abs(RtR(r, c) - (r == c ? 1.0 : 0.0)));
-  }
-  const double det = math::dot(math::cross(T.R.n, T.R.o), T.R.a);
-  if (error > 1e-6 || det < 0) {
-    throw BadArgument{fmt::format(
-        "--T: the rotation part is not a rotation matrix (|RtR - I| = {:.2g}, det = {:.6g}); give "
-        "the nine r numbers of an orthonormal, right-handed frame",
-        error, det)};
-  }
-  return T;
-}
-
 int run_ik(const IkArgs& args) {
   const auto k = args.robot.load();
-  const math::Transform pose = pose_from(args.T);
+  // Within the position database's bound: no robot reaches beyond it, and a larger value is a
+  // typo (exit 2, not "unreachable").
+  const math::Transform pose = pose_from(args.pose, rccl::kMaxPosition_m);
   kin::IkOptions options;
   if (!args.config.empty()) {
     const auto names = k->configuration_names();
@@ -309,14 +291,11 @@ void add_kin_command(CLI::App& app, int& exit_code) {
   auto ik = std::make_shared<IkArgs>();
   CLI::App* ik_cmd = kin->add_subcommand(
       "ik",
-      "Inverse kinematics: joint values within limits for a T6 pose. Exit code 3 when the "
-      "pose cannot be reached (the reason goes to stderr), 2 for bad arguments");
+      "Inverse kinematics: joint values within limits for a T6 pose, given as --T or as --xyz "
+      "and --rpy. Exit code 3 when the pose cannot be reached (the reason goes to stderr), 2 "
+      "for bad arguments");
   add_robot_options(*ik_cmd, ik->robot);
-  ik_cmd
-      ->add_option("--T", ik->T,
-                   "Pose as 12 comma-separated numbers, row by row: r11,r12,r13,px,r21,r22,r23,py,"
-                   "r31,r32,r33,pz (r: rotation matrix, p: position in m)")
-      ->required();
+  add_pose_options(*ik_cmd, ik->pose, "T6 (wrist frame) in the base frame");
   CLI::Option* config_opt = ik_cmd->add_option(
       "--config", ik->config,
       "Configuration to solve for: PUMA l|r (arm) u|d (elbow) n|f (wrist), e.g. lun; Microbo n|f "

@@ -7,6 +7,7 @@
 #include <cstring>
 #include <filesystem>
 #include <iostream>
+#include <memory>
 
 #include "rccx/io/console.hpp"
 #include "rccx/io/input.hpp"
@@ -40,8 +41,17 @@ int run_teach(const TeachArgs& a) {
         type == std::filesystem::file_type::directory ? "a directory" : "not a regular file")};
   }
   try {
+    // An existing file is opened now (a foreign or damaged one is said before the session); a
+    // missing one is created at the first `save`, so a session that saves nothing leaves none.
+    std::unique_ptr<rccl::PositionDb> db;
+    if (std::filesystem::exists(file, ec)) {
+      db = std::make_unique<rccl::PositionDb>(file, rccl::PositionDb::Open::existing);
+    }
+    const auto open_db = [&]() -> rccl::PositionDb& {
+      if (!db) db = std::make_unique<rccl::PositionDb>(file, rccl::PositionDb::Open::create);
+      return *db;
+    };
     rtc::SimulatedRobot robot(std::move(model));
-    rccl::PositionDb db(file);
     rccl::Manipulator arm(*robot.session);
     arm.start();
     // Ctrl-C ends a wait for a line; also one during the start-up (main() installed the
@@ -49,7 +59,8 @@ int run_teach(const TeachArgs& a) {
     io::StopAwareInput input(STDIN_FILENO, 0);
     std::istream in(&input);
     const rccl::Taught t = rccl::teach_loop(
-        arm, {in, std::cout, &db, [&](std::size_t j, double e) { robot.push(j, e); }});
+        arm,
+        {in, std::cout, db.get(), [&](std::size_t j, double e) { robot.push(j, e); }, open_db});
     fmt::print("\ntaught T6: p = ({:.3f}, {:.3f}, {:.3f}) mm\n", t.t6.p.x * 1e3, t.t6.p.y * 1e3,
                t.t6.p.z * 1e3);
     std::fflush(stdout);
@@ -89,7 +100,8 @@ void add_teach_command(CLI::App& app, int& exit_code) {
       "teach",
       "Teach positions by hand on a simulated robot (thesis 4.5.4.4), one command a line on "
       "stdin: Z / z zero gravity, push J E S, m J V (deg or mm), p pendant mode (J+ J- x+ rx- "
-      "s V q), xd / xr / xR examine, h / H hand, save NAME (to the database), e exit, ? menu.");
+      "s V q), xd / xr / xR examine, h / H hand, save NAME (to the database, created at the "
+      "first save), e exit, ? menu.");
   add_robot_options(*cmd, args->robot);
   cmd->add_option("--db", args->db, "Position database (default $RCCX_DB, else ./rccx.db)")
       ->check(not_empty());

@@ -33,6 +33,10 @@ Rot3 Rot3::from_rpy(double roll_rad, double pitch_rad, double yaw_rad) noexcept 
   return rot_z(roll_rad) * rot_y(pitch_rad) * rot_x(yaw_rad);
 }
 
+Rot3 Rot3::from_urdf_rpy(double roll_rad, double pitch_rad, double yaw_rad) noexcept {
+  return from_rpy(yaw_rad, pitch_rad, roll_rad);  // the same product, the angles named apart
+}
+
 Rot3 Rot3::from_zyz(double phi_rad, double theta_rad, double psi_rad) noexcept {
   return rot_z(phi_rad) * rot_y(theta_rad) * rot_z(psi_rad);
 }
@@ -47,6 +51,11 @@ std::array<double, 3> Rot3::to_rpy() const noexcept {
     return {roll, pitch, 0.0};
   }
   return {std::atan2(n.y, n.x), pitch, std::atan2(o.z, a.z)};
+}
+
+std::array<double, 3> Rot3::to_urdf_rpy() const noexcept {
+  const auto paul = to_rpy();
+  return {paul[2], paul[1], paul[0]};
 }
 
 std::array<double, 3> Rot3::to_zyz() const noexcept {

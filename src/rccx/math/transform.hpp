@@ -69,6 +69,10 @@ struct Rot3 {
   static Rot3 about(const Vec3& axis, double angle_rad) noexcept;
   /// Roll-pitch-yaw as Paul defines it: Rot(z, roll) Rot(y, pitch) Rot(x, yaw).
   static Rot3 from_rpy(double roll_rad, double pitch_rad, double yaw_rad) noexcept;
+  /// Roll-pitch-yaw as URDF (and ROS) define it, the reverse of Paul's: about the fixed axes,
+  /// roll about x first, then pitch about y, then yaw about z: Rot(z, yaw) Rot(y, pitch)
+  /// Rot(x, roll). Paul's from_rpy(yaw, pitch, roll) is the same rotation.
+  static Rot3 from_urdf_rpy(double roll_rad, double pitch_rad, double yaw_rad) noexcept;
   /// Z-Y-Z Euler angles: Rot(z, phi) Rot(y, theta) Rot(z, psi).
   static Rot3 from_zyz(double phi_rad, double theta_rad, double psi_rad) noexcept;
 
@@ -94,6 +98,9 @@ struct Rot3 {
   /// {roll, pitch, yaw} with pitch in [-pi/2, pi/2]; at pitch = +-pi/2 roll takes all of the
   /// rotation about z and yaw is 0.
   [[nodiscard]] std::array<double, 3> to_rpy() const noexcept;
+  /// {roll about x, pitch about y, yaw about z} of URDF (see from_urdf_rpy), pitch in
+  /// [-pi/2, pi/2]; at pitch = +-pi/2 yaw takes all of the rotation about z and roll is 0.
+  [[nodiscard]] std::array<double, 3> to_urdf_rpy() const noexcept;
   /// {phi, theta, psi} with theta in [0, pi]; at theta = 0 or pi, psi is 0.
   [[nodiscard]] std::array<double, 3> to_zyz() const noexcept;
   /// The angle-axis form: unit axis and angle in [0, pi].

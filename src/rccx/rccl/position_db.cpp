@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <memory>
 #include <thread>
 
@@ -224,12 +225,24 @@ void PositionDb::check(const StoredTransform& t) {
   if (t.created_unix_s < 0 || t.changed_unix_s < 0) {
     throw InvalidTransform(fmt::format("{}: times are seconds since 1970, 0 or more", what));
   }
-  if (!is_rigid(t.value)) {
-    throw InvalidTransform(
-        fmt::format("{}: not a rigid transform (its rotation must be orthonormal and "
-                    "right-handed, every element finite)",
-                    what));
+  if (const std::string problem = value_problem(t.value); !problem.empty()) {
+    throw InvalidTransform(fmt::format("{}: {}", what, problem));
   }
+}
+
+std::string PositionDb::value_problem(const math::Transform& value) {
+  if (!is_rigid(value)) {
+    return "not a rigid transform (its rotation must be orthonormal and right-handed, every "
+           "element finite)";
+  }
+  const math::Vec3& p = value.p;
+  if (std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)}) > kMaxPosition_m) {
+    return fmt::format(
+        "position ({:g}, {:g}, {:g}) m is beyond {:g} m of the origin; give x, y and z within "
+        "+-{:g} m",
+        p.x, p.y, p.z, kMaxPosition_m, kMaxPosition_m);
+  }
+  return {};
 }
 
 PositionDb::PositionDb(const std::filesystem::path& file, Open mode,

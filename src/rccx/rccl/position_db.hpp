@@ -10,8 +10,10 @@
 //
 // Names: 1 to 32 characters (the thesis raised RCCL's limit to 32), letters, digits and _ - .
 // Robot names follow the same rule; a configuration is up to 8 letters; a note is UTF-8 text
-// without control characters, up to 1000 bytes. put() refuses anything else (InvalidTransform),
-// so what is stored can be printed and exported as it is.
+// without control characters, up to 1000 bytes. A value is a rigid transform: every element
+// finite, the rotation orthonormal and right-handed (1e-6), the position within
+// kMaxPosition_m (100 m) of the origin on each axis. put() refuses anything else
+// (InvalidTransform), so what is stored can be printed and exported as it is.
 #pragma once
 
 #include <chrono>
@@ -63,6 +65,10 @@ inline constexpr std::size_t kMaxTransformName = 32;
 inline constexpr std::size_t kMaxRobotName = 32;
 inline constexpr std::size_t kMaxConfiguration = 8;  ///< letters, e.g. "lun"
 inline constexpr std::size_t kMaxNote = 1000;        ///< bytes of UTF-8
+/// |px|, |py| and |pz| of a stored transform at most this (m), as a cell file's lengths: a
+/// workcell's frames (T6 or not: an object, a fixture) lie within it, a larger value is a typo,
+/// and mm and products of transforms stay finite.
+inline constexpr double kMaxPosition_m = 100.0;
 
 struct StoredTransform {
   std::string robot;  ///< the robot it belongs to ("microbo", "puma560" ...), a name as `name`
@@ -127,6 +133,10 @@ class PositionDb {
   /// Throws InvalidTransform unless put() would store `t`: every rule above, without opening
   /// a database.
   static void check(const StoredTransform& t);
+  /// Why put() would refuse `value` ("" when it would store it): an element not finite, a
+  /// rotation not orthonormal and right-handed, a position beyond kMaxPosition_m. Also for a
+  /// row read back that another program wrote.
+  static std::string value_problem(const math::Transform& value);
 
  private:
   void migrate();

@@ -346,7 +346,9 @@ class Loop {
   }
 
   void save(const std::string& name) {
-    if (io_.db == nullptr) throw Refused("save: no position database (--db FILE)");
+    if (io_.db == nullptr && !io_.open_db) {
+      throw Refused("save: no position database (--db FILE)");
+    }
     const kin::JointVector now = q();
     for (std::size_t j = 0; j < model_.dof(); ++j) {
       const kin::Joint& J = model_.joints[j];
@@ -363,6 +365,8 @@ class Loop {
     t.name = name;
     t.value = arm_.kinematics().forward(now);
     t.note = "taught";
+    PositionDb::check(t);  // a bad name creates no file
+    if (io_.db == nullptr) io_.db = &io_.open_db();
     io_.db->put(t);
     say("  saved {} for {} in {}\n", name, model_.name, io_.db->path().string());
   }

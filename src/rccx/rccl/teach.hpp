@@ -41,6 +41,9 @@ struct TeachIo {
   /// A simulated hand pushing joint (0-based) with an effort (N m or N); empty when the robot
   /// cannot be pushed.
   std::function<void(std::size_t joint, double effort)> push;
+  /// When `db` is null: opens (creates) the database at the first `save`, so that a session
+  /// that saves nothing leaves no file. Empty: `save` is refused.
+  std::function<PositionDb&()> open_db = {};  // = {}: callers may leave it out, unwarned
 };
 
 struct Taught {
