@@ -224,7 +224,7 @@ TEST_F(BadInput, UnknownWords) {
       {"", "report --zzzzzzz", 2, "unknown option '--zzzzzzz' for `rccx report`\nRun", ""},
       {"", "limp --seconds 3", 2, "unknown option '--seconds' for `rccx limp`", ""},
       // CLI11's own errors point at the command's help too.
-      {"", "kin ik --robot puma560", 2, "Run `rccx kin ik --help`", ""},
+      {"", "kin fk --robot", 2, "Run `rccx kin fk --help`", ""},
   });
 }
 

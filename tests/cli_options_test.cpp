@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "cli_tree.hpp"
+#include "rccx/io/spelling.hpp"
 #include "shell_run.hpp"
 
 namespace {
@@ -240,7 +241,7 @@ TEST(CliOptions, BashCompletionComesFromTheCommandsOwnDefinition) {
 
 TEST(CliOptions, NearestWordIsATypoOfIt) {
   using rccx::tools::nearest;
-  EXPECT_EQ(rccx::tools::edit_distance("rprt", "report"), 2U);
+  EXPECT_EQ(rccx::io::edit_distance("rprt", "report"), 2U);
   EXPECT_EQ(nearest("rprt", {"report", "rcu", "calib"}), "report");
   EXPECT_EQ(nearest("fx", {"fk", "ik", "robots"}), "fk");
   EXPECT_EQ(nearest("--secnds", {"--seconds", "--every"}), "--seconds");

@@ -157,11 +157,14 @@ TEST(RcclSession, WasherLogShowsTheWindowFollowedOnItsEdges) {
   for (std::size_t i = 0; i < cartesian.size(); ++i) {
     const std::uint64_t id = cartesian[i];
     const math::Vec3 from = corners[i % 4], to = corners[(i + 1) % 4];
-    // The log's time is the sample the setpoint went out in; keep two periods clear of the
+    // Events carry the time of the sample they were computed in; the log's time is the sample
+    // the setpoint went out in, the pipeline's two periods later. Keep two periods clear of the
     // transitions either side.
-    const double begin = time_of(rccl::EventKind::ended, id - 1) + 2 * period_s;
-    const double end =
-        i + 1 < cartesian.size() ? time_of(rccl::EventKind::started, id + 1) - 2 * period_s : 1e9;
+    const double pipeline_s = 2 * period_s;
+    const double begin = time_of(rccl::EventKind::ended, id - 1) + pipeline_s + 2 * period_s;
+    const double end = i + 1 < cartesian.size()
+                           ? time_of(rccl::EventKind::started, id + 1) + pipeline_s - 2 * period_s
+                           : 1e9;
     for (const LogRow& r : rows) {
       const bool next_cartesian = i + 1 < cartesian.size();
       if (r.seg == static_cast<int>(id) || (next_cartesian && r.seg == static_cast<int>(id) + 1)) {

@@ -61,6 +61,8 @@ TABLE = {
         Expect(0, r"^puma560 .*: \d solution\(s\) within limits"),
     "rccx kin ik --robot microbo --T 1,0,0,0.325,0,-1,0,0.15,0,0,-1,0.25 --config n":
         Expect(0, r"^ +d3 = +0\.35794\d* m"),
+    "rccx kin ik --robot microbo --xyz 325mm,150mm,250mm --rpy 180deg,0,0 --config n":
+        Expect(0, r"^ +d3 = +0\.35794\d* m"),
     "rccx report --seconds 2": Expect(0, r"^t +[\d.]+ s +theta1 +-?[\d.]+ deg d2 +[\d.]+ mm"),
     "rccx report --robot puma560 --realtime --period 1ms --seconds 10":
         Expect(0, r"latency", loaded=r"^report: control was restarted \d+ times? after overruns"),
@@ -73,6 +75,10 @@ TABLE = {
     "RCCX_LOG=washer.csv build/release/examples/washer_c": Expect(0, r"^velocity 110, 120"),
     "build/release/examples/c_guarded": Expect(0, r"^touched at z = [\d.]+ mm"),
     DB_PUT: Expect(0, r"PICK", file="rccx.db"),  # SQLite keeps the name as text
+    "rccx db put --robot microbo PLACE --xyz 325mm,-150mm,250mm --rpy 180deg,0,0":
+        Expect(0, r"PLACE", file="rccx.db"),
+    "rccx db put --new-robot gantry HOME --xyz 0,0,1 --rpy 0,0,0":
+        Expect(0, r"gantry", file="rccx.db"),
     "rccx db list --robot microbo": Expect(0, r"^microbo PICK: x 325\.000 .*\(over the table\)"),
     "rccx db export cell.json": Expect(0, r'"PICK"', file="cell.json"),
     "rccx teach --robot puma560 --db cell.db":
@@ -82,8 +88,8 @@ TABLE = {
     "rccx view --cell cells/cvarl.json": Expect(130, ADDRESS, serve=True),
     "RCCX_LOG=run.csv build/release/examples/04_washer": Expect(0, WASHER),
     "rccx view --log run.csv": Expect(130, ADDRESS, serve=True),
-    "rccx plot run.csv -o run.svg": Expect(0, r"^run\.csv: \d+ samples, [\d.]+ s -> run\.svg"),
-    "rccx plot run.csv -o run.png": Expect(0, r"^run\.csv: \d+ samples, [\d.]+ s -> run\.png"),
+    "rccx plot run.csv -o run.svg": Expect(0, r"^run\.csv: robot microbo .*, \d+ samples, [\d.]+ s, worst path error [\d.]+ mm .*-> run\.svg"),
+    "rccx plot run.csv -o run.png": Expect(0, r"^run\.csv: robot microbo .*, \d+ samples, [\d.]+ s, worst path error [\d.]+ mm .*-> run\.png"),
 }
 
 

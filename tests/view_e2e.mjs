@@ -216,7 +216,9 @@ try {
     p.on('exit', resolve);
   });
   check(rec === 0 && existsSync(csv), `a run recorded with RCCX_LOG (${rec})`);
-  const lines = readFileSync(csv, 'utf8').trim().split('\n');
+  // The log's first line names its robot (`# rccx-log 1 robot=...`); the column line follows.
+  const lines = readFileSync(csv, 'utf8').trim().split('\n').filter((l) => !l.startsWith('#'));
+  check(readFileSync(csv, 'utf8').startsWith('# rccx-log 1 robot=microbo '), 'the log says its robot');
   const header = lines[0].split(',');
   const dof = (header.length - 8) / 2;
   const rows = lines.slice(1).map((l) => l.split(',').map(Number));

@@ -14,6 +14,7 @@
 #include "db_command.hpp"
 #include "kin_command.hpp"
 #include "plot_command.hpp"
+#include "rccx/io/spelling.hpp"
 #include "rcu_command.hpp"
 #include "rtc_commands.hpp"
 #include "teach_command.hpp"
@@ -221,21 +222,6 @@ Words check_words(const CLI::App& root, const std::vector<std::string>& args) {
   return w;
 }
 
-std::size_t edit_distance(std::string_view a, std::string_view b) {
-  std::vector<std::size_t> row(b.size() + 1);
-  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
-  for (std::size_t i = 1; i <= a.size(); ++i) {
-    std::size_t diagonal = row[0];
-    row[0] = i;
-    for (std::size_t j = 1; j <= b.size(); ++j) {
-      const std::size_t above = row[j];
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
-      diagonal = above;
-    }
-  }
-  return row[b.size()];
-}
-
 std::string nearest(std::string_view word, const std::vector<std::string>& known) {
   const std::string_view bare = word.substr(std::min(word.find_first_not_of('-'), word.size()));
   // A typo of a short word is one letter; of a longer one, up to a third of its letters.
@@ -243,7 +229,7 @@ std::string nearest(std::string_view word, const std::vector<std::string>& known
   std::string best;
   std::size_t best_distance = allowed + 1;
   for (const std::string& k : known) {
-    std::size_t d = edit_distance(word, k);
+    std::size_t d = io::edit_distance(word, k);
     if (bare.size() >= 2 && k.starts_with(word)) d = std::min<std::size_t>(d, 1);  // "--sec"
     if (d < best_distance) {
       best = k;

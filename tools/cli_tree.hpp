@@ -44,9 +44,6 @@ void complete_with(const CLI::Option* option, std::vector<std::string> words);
 /// A bash completion script for the tree: its commands, options and their known values.
 std::string bash_completion(const CLI::App& root);
 
-/// Levenshtein distance: insertions, deletions and substitutions from `a` to `b`.
-std::size_t edit_distance(std::string_view a, std::string_view b);
-
 /// The word of `known` nearest `word` when it is near enough to be a typo of it, else "".
 std::string nearest(std::string_view word, const std::vector<std::string>& known);
 

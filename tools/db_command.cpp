@@ -23,6 +23,7 @@
 #include "rccx/io/file.hpp"
 #include "rccx/io/parse.hpp"
 #include "rccx/io/signals.hpp"
+#include "rccx/io/spelling.hpp"
 #include "rccx/kinematics/robot_model.hpp"
 #include "rccx/math/units.hpp"
 #include "rccx/rccl/position_db.hpp"
@@ -221,22 +222,12 @@ std::string joined(const std::set<std::string>& names) {
 
 /// The edit distance of a and b, letters compared without case: how near a typo is to a name.
 std::size_t distance(std::string_view a, std::string_view b) {
-  const auto lower = [](char c) {
-    return static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  const auto lower = [](std::string_view w) {
+    std::string out(w);
+    for (char& c : out) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return out;
   };
-  std::vector<std::size_t> row(b.size() + 1);
-  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
-  for (std::size_t i = 1; i <= a.size(); ++i) {
-    std::size_t diagonal = row[0];
-    row[0] = i;
-    for (std::size_t j = 1; j <= b.size(); ++j) {
-      const std::size_t above = row[j];
-      const std::size_t change = lower(a[i - 1]) == lower(b[j - 1]) ? 0 : 1;
-      row[j] = std::min({above + 1, row[j - 1] + 1, diagonal + change});
-      diagonal = above;
-    }
-  }
-  return row[b.size()];
+  return io::edit_distance(lower(a), lower(b));
 }
 
 /// Throws BadArgument unless `robot` is known, naming the nearest known robot; `then` says what
