@@ -196,6 +196,8 @@ TEST_F(BadInput, ControlPrograms) {
       {"", "jointtest --log /dev/full < /dev/null", 1, "the sample log is lost", ""},
       {"RCCX_LOG=/dev/full", "jointtest < /dev/null", 1, "the sample log is lost", ""},
       {"RCCX_LOG=/dev/full", "teach --db DIR/t.db < /dev/null", 1, "the sample log is lost", ""},
+      {"RCCX_LOG=/dev/full", "view --robot microbo --port 0 --fast --seconds 0.5", 1,
+       "the sample log is lost", ""},
   });
 }
 

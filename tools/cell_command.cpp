@@ -189,21 +189,6 @@ struct LoadArgs {
   bool json = false;
 };
 
-/// Closes every robot's session, its RCCX_LOG log put in place (one file a robot, named by its
-/// name in the cell); true when one is lost (a full disk, an I/O error), said on stderr.
-bool logs_lost(cell::Cell& c) {
-  bool lost = false;
-  for (const std::string& name : c.robot_names()) {
-    rtc::Session& s = c.session(name);
-    s.close();
-    if (!s.log_problem().empty()) {
-      io::eprint("error: robot {}'s sample log is lost: {}\n", name, s.log_problem());
-      lost = true;
-    }
-  }
-  return lost;
-}
-
 int run_load(const LoadArgs& a) {
   std::size_t n = 0;
   const std::chrono::nanoseconds period = a.period.value;
@@ -298,7 +283,7 @@ int run_load(const LoadArgs& a) {
                  rtc::to_string(ended.code), ended.detail.data());
     }
   }
-  return logs_lost(c) || failed > 0 ? kFailure : kOk;
+  return !c.finish_logs("error") || failed > 0 ? kFailure : kOk;
 }
 
 }  // namespace

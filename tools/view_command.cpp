@@ -135,7 +135,7 @@ int run_robot(const ViewArgs& a) {
     }
   }
   (void)arm.stop_control();
-  return code;
+  return robot.finish_logs("rccx view") ? code : kFailure;  // RCCX_LOG's log, whole or said
 }
 
 int run_cell(const ViewArgs& a) {
@@ -187,7 +187,7 @@ int run_cell(const ViewArgs& a) {
     // A collision stop is the cell's check at work: the sweep goes on. Control that ended does not.
     if (ended || w == rccl::WaitResult::session_ended) return kFailure;
   }
-  return kOk;
+  return c.finish_logs("rccx view") ? kOk : kFailure;  // RCCX_LOG's logs, whole or said
 }
 
 int run_view(const ViewArgs& a) {

@@ -394,6 +394,20 @@ std::vector<std::string> Cell::robot_names() const {
   return names;
 }
 
+bool Cell::finish_logs(std::string_view program) {
+  bool whole = true;
+  for (const auto& r : robots_) {
+    rtc::Session& s = session(r->name);
+    s.close();
+    if (!s.log_problem().empty()) {
+      fmt::print(stderr, "{}: robot {}'s sample log is lost: {}\n", program, r->name,
+                 s.log_problem());
+      whole = false;
+    }
+  }
+  return whole;
+}
+
 const math::Transform& Cell::base(std::string_view name) const {
   return model_.robots[index(name)].base;
 }

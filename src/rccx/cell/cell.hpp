@@ -128,6 +128,11 @@ class Cell {
   /// tests that push or fault it between samples of simulated time.
   [[nodiscard]] rtc::SimulatedHardware& hardware(std::string_view name);
   [[nodiscard]] std::vector<std::string> robot_names() const;
+  /// Closes every robot's session, its RCCX_LOG log put in place (one file a robot, named by its
+  /// name in the cell). True when every log is whole (or there is none); a lost one (a full
+  /// disk, an I/O error) is said on stderr as "<program>: robot <name>'s sample log is lost: ..."
+  /// so that a program's exit code can check it: `return cell.finish_logs("demo") ? 0 : 1;`.
+  bool finish_logs(std::string_view program);
   /// The index of a robot in the model (the order of the cell file); throws like robot().
   [[nodiscard]] std::size_t index(std::string_view name) const;
   [[nodiscard]] const CellModel& model() const noexcept { return model_; }
