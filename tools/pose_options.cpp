@@ -121,7 +121,7 @@ math::Transform pose_from(const PoseArgs& pose, double max_position_m) {
   }
   if (!pose.T.empty()) {
     const std::vector<double> v = io::parse_number_list(
-        pose.T, "--T", 12, {-max_position_m, max_position_m, "(rotation) or m (position)"});
+        pose.T, "--T", 12, {-max_position_m, max_position_m, "(m for px, py, pz)"});
     std::array<double, 12> rows{};
     std::copy(v.begin(), v.end(), rows.begin());
     const math::Transform T = math::Transform::from_rows(rows);

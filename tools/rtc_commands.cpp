@@ -82,14 +82,27 @@ double every_of(const Duration& every, const SimulatedRobot& r) {
   return every.seconds();
 }
 
-/// The times of the reports: every `every` seconds, and the end of the run, which is `seconds`
-/// however long `every` is.
-std::vector<double> report_times(double seconds, double every) {
-  std::vector<double> times;
-  for (double k = 1; k * every < seconds - 1e-9; ++k) times.push_back(k * every);
-  times.push_back(seconds);
-  return times;
-}
+/// The times of the reports, one at a time: every `every` seconds, and the end of the run, which
+/// is `seconds` however long `every` is. Not a list: a long run with a short interval
+/// (`--seconds 1e6 --every 10ms`) must not hold every time in memory before it starts.
+class ReportTimes {
+ public:
+  ReportTimes(double seconds, double every) : seconds_(seconds), every_(every) {}
+  /// The next report's time (s) into `at`; false once the end of the run has been given.
+  bool next(double& at) {
+    if (last_given_) return false;
+    ++k_;
+    last_given_ = !(k_ * every_ < seconds_ - 1e-9);
+    at = last_given_ ? seconds_ : k_ * every_;
+    return true;
+  }
+
+ private:
+  double seconds_;
+  double every_;
+  double k_ = 0.0;
+  bool last_given_ = false;
+};
 
 /// A real-time report measures on after control ends with an overrun (the machine missed a
 /// deadline): it says so and restarts control; the run then fails (exit 1) at the end.
@@ -137,7 +150,8 @@ int run_report(const ReportArgs& a) {
   r.session->control({}, {});  // empty f1 and f2: the full cycle, nothing commanded
   std::uint64_t restarts = 0;
   rtc::Termination t;
-  for (const double at : report_times(a.seconds.seconds(), every)) {
+  ReportTimes times(a.seconds.seconds(), every);
+  for (double at = 0.0; times.next(at);) {
     if (t.ended() || io::stop_count() != 0) break;
     t = wait_to(r, at);
     if (!a.json) print_positions(r.model, r.session->how());
@@ -261,7 +275,8 @@ int run_marsh(const MarshArgs& a) {
   fmt::print("zero gravity: the joints follow a push and stay where they are left{}\n",
              pushes.empty() ? "" : " (pushing for the first half)");
   const double seconds = a.seconds.seconds();
-  for (const double at : report_times(seconds, every)) {
+  ReportTimes times(seconds, every);
+  for (double at = 0.0; times.next(at);) {
     if (io::stop_count() != 0) break;
     // Between samples of simulated time the arm is the planning level's to touch.
     const bool pushing = at - every < seconds / 2;
