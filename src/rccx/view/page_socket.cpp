@@ -12,12 +12,7 @@
 
 namespace rccx::view::detail {
 
-namespace asio = boost::asio;
-namespace beast = boost::beast;
-namespace http = beast::http;
 namespace websocket = beast::websocket;
-using tcp = asio::ip::tcp;
-using json = nlohmann::json;
 
 class PageSocket : public std::enable_shared_from_this<PageSocket> {
  public:

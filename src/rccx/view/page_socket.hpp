@@ -25,6 +25,13 @@
 
 namespace rccx::view::detail {
 
+// The names the server's files (routes, page_socket) share.
+namespace asio = boost::asio;
+namespace beast = boost::beast;
+namespace http = beast::http;
+using tcp = asio::ip::tcp;
+using json = nlohmann::json;
+
 struct Site;
 class PageSocket;
 
