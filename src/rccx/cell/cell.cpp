@@ -450,7 +450,7 @@ rccl::TransformPtr Cell::tool_frame(std::string_view leader) const {
   const Robot* r = &find(leader);
   // The Robot outlives the transform only while the cell lives: a transform used after the
   // cell is gone is a misuse, as a session's would be.
-  return rccl::functional(r->name + "_TOOL", [r](const rccl::SampleContext& ctx) {
+  rccl::TransformPtr t = rccl::functional(r->name + "_TOOL", [r](const rccl::SampleContext& ctx) {
     ToolSample s;
     r->published.load(s);
     // Extrapolated to the time the reader's setpoint is for (a follower sampled more slowly,
@@ -462,6 +462,8 @@ rccl::TransformPtr Cell::tool_frame(std::string_view leader) const {
     p.R = rotate(p.R, s.angular_velocity_rad_s, dt);
     return p;
   });
+  t->set_reference("frame:" + r->name);  // a serve process resolves it by the robot's name
+  return t;
 }
 
 rccl::TransformPtr Cell::in_base_of(std::string_view robot,

@@ -73,6 +73,11 @@ class Position {
   /// How many factors the goal and tool products have after constants were multiplied.
   [[nodiscard]] std::size_t goal_factor_count() const noexcept { return goal_.size(); }
   [[nodiscard]] std::size_t tool_factor_count() const noexcept { return tool_.size(); }
+  /// The equation's sides as written and its tool (T6 itself: none); empty for joints. What a
+  /// position is sent across processes as (net::encode_position).
+  [[nodiscard]] const std::vector<TransformPtr>& lhs() const noexcept { return lhs_; }
+  [[nodiscard]] const std::vector<TransformPtr>& rhs() const noexcept { return rhs_; }
+  [[nodiscard]] const TransformPtr& tool_transform() const noexcept { return tool_transform_; }
 
   /// Planning level: T6 for the present values (hold transforms as last set). Only for
   /// positions without functional transforms (otherwise std::logic_error).

@@ -65,6 +65,13 @@ class Transform {
 
   [[nodiscard]] const std::string& name() const noexcept { return name_; }
   [[nodiscard]] TransformKind kind() const noexcept { return kind_; }
+  /// How a process that cannot call this functional transform's function names it, so that a
+  /// position using it can be sent across processes (docs/NETWORK.md): "frame:<robot>" (that
+  /// robot's commanded T6 TOOL in the world), "function:<name>" (registered in the serve
+  /// process), "stream:<name>" (samples the program writes). Empty: not sendable.
+  [[nodiscard]] const std::string& reference() const noexcept { return reference_; }
+  /// Set before the transform is used in a motion (planning level).
+  void set_reference(std::string reference) { reference_ = std::move(reference); }
 
   /// A constant's value, or the value a hold transform was last set to (planning level).
   [[nodiscard]] const math::Transform& value() const noexcept { return planning_value_; }
@@ -87,6 +94,7 @@ class Transform {
 
  private:
   std::string name_;
+  std::string reference_;
   TransformKind kind_;
   math::Transform planning_value_;
   TransformFunction function_;
