@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "cell_helpers.hpp"
@@ -412,4 +413,86 @@ TEST(CellRuntime, TheToolFrameIsTheKinematicsT6OfTheLastSetpoint) {
     EXPECT_LT(math::max_abs_difference(c->tool_sample(name).pose, expected), 1e-9) << name;
     EXPECT_DOUBLE_EQ(c->tool_sample(name).t_s, m.generator().last_setpoint_time_s()) << name;
   }
+}
+
+namespace {
+
+/// Another process's robot as the network layer would give it: fixed joints of a given age.
+class FixedRemote : public cell::RemoteRobotSource {
+ public:
+  kin::JointVector q;
+  double age_s = 0.0;
+  bool latest(std::size_t remote, kin::JointVector& out, double& age) const noexcept override {
+    if (remote != 0) return false;
+    out = q;
+    age = age_s;
+    return true;
+  }
+};
+
+/// Runs the PUMA alone (the Microbo served elsewhere, standing with its tool 40 mm to the
+/// PUMA's side of the board's centre) towards the Microbo's side; returns the closest the two
+/// came (m), how far the PUMA's tool went before it stood (m) and the PUMA's failure text.
+std::tuple<double, double, std::string> puma_towards_a_remote_microbo(double remote_age_s) {
+  cell::CellOptions options;
+  options.local_robots = {"puma"};
+  cell::Cell c(cell::load_cell_file(kCvarl), options);
+  const cell::CellRobot& m = *c.model().find_robot("microbo");
+  const auto k = kin::make_kinematics(m.model);
+  const math::Transform goal =
+      m.base.inverse() * down_at(kAbove + math::Vec3{-0.04, 0, 0}) * m.tool->inverse();
+  const kin::IkResult ik = k->inverse(goal);
+  EXPECT_TRUE(ik) << "the Microbo's pose is out of its reach";
+  FixedRemote remote;
+  remote.q = ik.q;
+  remote.age_s = remote_age_s;
+  c.set_remote_source(&remote);
+  const std::shared_ptr<double> closest = watch_closest(c);
+  c.start();
+  rccl::Manipulator& puma = c.robot("puma");
+  const math::Vec3 from = c.tool_sample("puma").pose.p;
+  const rccl::Motion a =
+      puma.move(world_position(c, "puma", "PX", down_at(kAbove + math::Vec3{0.04, 0, 0})));
+  EXPECT_EQ(puma.waitfor(a.end(), 20s), rccl::WaitResult::failed) << failures_of(puma);
+  c.wait_for(500ms);
+  return {*closest, (c.tool_sample("puma").pose.p - from).norm(),
+          puma.failures().empty() ? "" : std::string(puma.failures()[0].message())};
+}
+
+}  // namespace
+
+TEST(CellRuntime, AnotherProcesssRobotIsInTheCollisionCheckWithItsStatesAgeInTheMargin) {
+  const double margin_m = cell::load_cell_file(kCvarl).collision_margin_m;
+  const auto [fresh_m, fresh_travel_m, fresh_why] = puma_towards_a_remote_microbo(0.0);
+  EXPECT_GE(fresh_m, margin_m) << "the PUMA came within the margin of the remote Microbo";
+  EXPECT_NE(fresh_why.find("microbo"), std::string::npos) << fresh_why;
+  EXPECT_NE(fresh_why.find("another process's"), std::string::npos) << fresh_why;
+  // A state 100 ms old: the Microbo may have moved since, so the PUMA stops sooner.
+  const auto [old_m, old_travel_m, old_why] = puma_towards_a_remote_microbo(0.1);
+  EXPECT_GE(old_m, margin_m);
+  EXPECT_LT(old_travel_m, fresh_travel_m - 0.005)
+      << "the age did not widen the margin: " << old_why << " (went " << old_travel_m * 1e3
+      << " mm against " << fresh_travel_m * 1e3 << " mm)";
+  EXPECT_NE(old_why.find("100 ms old"), std::string::npos) << old_why;
+}
+
+TEST(CellRuntime, ACellRunsOnlyItsLocalRobotsAndNamesTheOthersAsServedElsewhere) {
+  cell::CellOptions options;
+  options.local_robots = {"microbo"};
+  cell::Cell c(cell::load_cell_file(kCvarl), options);
+  EXPECT_EQ(c.robot_names(), std::vector<std::string>{"microbo"});
+  EXPECT_EQ(c.remote_names(), std::vector<std::string>{"puma"});
+  try {
+    (void)c.robot("puma");
+    FAIL() << "a remote robot was given as local";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("served by another process"), std::string::npos)
+        << e.what();
+  }
+  options.local_robots = {"pumaa"};
+  EXPECT_THROW(cell::Cell(cell::load_cell_file(kCvarl), options), std::invalid_argument);
+  // The remote robot's margin grows with its state's age at its joints' top speeds.
+  EXPECT_EQ(c.remote_allowance_m(0, 0.0), 0.0);
+  EXPECT_GT(c.remote_allowance_m(0, 0.1), 0.05);
+  EXPECT_NEAR(c.remote_allowance_m(0, 0.2), 2 * c.remote_allowance_m(0, 0.1), 1e-12);
 }

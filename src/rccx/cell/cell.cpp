@@ -165,16 +165,46 @@ rccl::StartWhen Cell::touching(const std::vector<std::string>& names) const {
   return w;
 }
 
+namespace {
+
+/// A robot's capsules (whole arm, shapes, tool), mounted on its object if it has one.
+void add_capsules(const CellModel& model, const CellRobot& cr, std::vector<RobotCapsules>& out) {
+  out.emplace_back(cr.model, cr.link_radius_m, cr.base, Cell::shapes_of(cr));
+  if (!cr.mounted_on.empty()) {
+    for (std::size_t k = 0; k < model.objects.size(); ++k) {
+      if (model.objects[k].name == cr.mounted_on) out.back().set_mounted_on(static_cast<int>(k));
+    }
+  }
+}
+
+}  // namespace
+
 Cell::Cell(CellModel model, CellOptions options)
     : model_(std::move(model)),
       options_(options),
       group_(std::make_unique<rtc::SessionGroup>(group_options(model_, options_))) {
   validate(model_);
+  for (const std::string& name : options_.local_robots) {
+    if (model_.find_robot(name) == nullptr) {
+      std::vector<std::string> known;
+      for (const CellRobot& cr : model_.robots) known.push_back(cr.name);
+      throw std::invalid_argument(
+          fmt::format("cell {}: no robot \"{}\" to run here; its robots: {}", model_.name, name,
+                      fmt::join(known, ", ")));
+    }
+  }
+  const auto local = [&](const std::string& name) {
+    return options_.local_robots.empty() ||
+           std::find(options_.local_robots.begin(), options_.local_robots.end(), name) !=
+               options_.local_robots.end();
+  };
   std::vector<RobotCapsules> capsules;
   for (std::size_t i = 0; i < model_.robots.size(); ++i) {
     const CellRobot& cr = model_.robots[i];
+    if (!local(cr.name)) continue;
     auto r = std::make_unique<Robot>();
     r->name = cr.name;
+    r->model_index = i;
     r->hardware = rtc::make_simulated_hardware(cr.model, true, options_.ideal_servo);
     r->session = &group_->add(*r->hardware.driver, static_cast<int>(cr.period_multiple), cr.name);
     r->manipulator = std::make_unique<rccl::Manipulator>(*r->session);
@@ -184,14 +214,7 @@ Cell::Cell(CellModel model, CellOptions options)
     r->tool = cr.tool.value_or(math::Transform::identity());
     r->period_s = std::chrono::duration<double>(model_.period(i)).count();
     r->lever_m = levers_m(cr);
-    const std::vector<RobotShape> shapes = shapes_of(cr);
-    capsules.emplace_back(cr.model, cr.link_radius_m, cr.base, shapes);
-    if (!cr.mounted_on.empty()) {
-      for (std::size_t k = 0; k < model_.objects.size(); ++k) {
-        if (model_.objects[k].name == cr.mounted_on)
-          capsules.back().set_mounted_on(static_cast<int>(k));
-      }
-    }
+    add_capsules(model_, cr, capsules);
     // Before its first setpoint a robot's tool frame is its ready pose.
     const kin::JointVector ready = cr.model.ready();
     ToolSample s;
@@ -209,6 +232,21 @@ Cell::Cell(CellModel model, CellOptions options)
     generators_.push_back(r->generator);
     robots_.push_back(std::move(r));
   }
+  // The other processes' robots, after the local ones in the collision world.
+  for (std::size_t i = 0; i < model_.robots.size(); ++i) {
+    const CellRobot& cr = model_.robots[i];
+    if (local(cr.name)) continue;
+    remote_names_.push_back(cr.name);
+    remote_model_index_.push_back(i);
+    const kin::JointVector lever = levers_m(cr);
+    double speed = 0.0;
+    for (std::size_t j = 0; j < cr.model.dof(); ++j) {
+      const double factor = cr.model.joints[j].type == kin::JointType::prismatic ? 1.0 : lever[j];
+      speed += factor * cr.model.joints[j].max_velocity;
+    }
+    remote_point_speed_m_per_s_.push_back(speed);
+    add_capsules(model_, cr, capsules);
+  }
   std::vector<Solid> solids;
   for (const CellObject& o : model_.objects) {
     solids.push_back(o.shape.kind == ShapeKind::box
@@ -219,6 +257,7 @@ Cell::Cell(CellModel model, CellOptions options)
                                             std::move(solids));
   check_clear_at_start();
   threats_.resize(world_->max_threats() + 1);
+  remote_age_s_.assign(remote_names_.size(), 0.0);
   group_->set_robot_hook([this](std::size_t i, std::uint32_t) { on_robot(i); });
   group_->set_cycle_hook([this](std::uint32_t tick) { on_cycle(tick); });
 }
@@ -374,6 +413,11 @@ std::size_t Cell::index(std::string_view name) const {
   for (std::size_t i = 0; i < robots_.size(); ++i) {
     if (robots_[i]->name == name) return i;
   }
+  if (std::find(remote_names_.begin(), remote_names_.end(), name) != remote_names_.end()) {
+    throw std::invalid_argument(
+        fmt::format("cell {}: robot \"{}\" is served by another process; this one runs {}",
+                    model_.name, name, fmt::join(robot_names(), ", ")));
+  }
   throw std::invalid_argument(fmt::format("cell {}: no robot \"{}\"; its robots: {}", model_.name,
                                           name, fmt::join(robot_names(), ", ")));
 }
@@ -409,7 +453,7 @@ bool Cell::finish_logs(std::string_view program) {
 }
 
 const math::Transform& Cell::base(std::string_view name) const {
-  return model_.robots[index(name)].base;
+  return model_.robots[find(name).model_index].base;
 }
 
 math::Transform Cell::world_to_base(std::string_view name,
@@ -507,7 +551,7 @@ void Cell::on_robot(std::size_t i) noexcept {
   if (world_->set_configuration(i, q)) {
     s.pose = world_->robot(i).link_frame(r.dof - 1) * r.tool;
   } else {  // a setpoint that is not finite: the capsules keep the last one
-    s.pose = model_.robots[i].base * r.manipulator->kinematics().forward(q) * r.tool;
+    s.pose = model_.robots[r.model_index].base * r.manipulator->kinematics().forward(q) * r.tool;
   }
   s.t_s = t;
   const ToolSample& before = r.last;
@@ -554,6 +598,7 @@ void Cell::on_cycle(std::uint32_t tick) noexcept {
       r.fresh = false;
     }
   }
+  if (!remote_names_.empty()) place_remote_robots(tick);
   if (options_.collision_checks) check_collisions();
   publish_ledgers();
   if (observer_) observer_(tick);
@@ -562,8 +607,11 @@ void Cell::on_cycle(std::uint32_t tick) noexcept {
 void Cell::check_collisions() noexcept {
   const std::size_t found = world_->threats(threats_);
   const std::size_t reported = std::min(found, threats_.size());
+  const std::size_t local = robots_.size();
   for (std::size_t k = 0; k < reported; ++k) {
     const Threat& t = threats_[k];
+    // Two remote robots: their own processes check them.
+    if (t.robot_a >= local) continue;
     Robot& a = *robots_[t.robot_a];
     const RobotCapsules& ca = world_->robot(t.robot_a);
     const Capsule& pa = ca.capsules()[t.capsule_a];
@@ -575,6 +623,16 @@ void Cell::check_collisions() noexcept {
                        "+ braking {:.3f} m)",
                        a.name, part_a, t.distance_m, model_.objects[t.b].name,
                        model_.collision_margin_m, a.braking_m);
+    } else if (t.b >= local) {
+      const RobotCapsules& cb = world_->robot(t.b);
+      const Capsule& pb = cb.capsules()[t.capsule_b];
+      const std::string_view part_b = part_name(cb, pb, buf_b);
+      io::format_fixed(
+          message_,
+          "collision stop: {} {} and {} {} (another process's, its state {:.0f} ms "
+          "old) would come {:.3f} m apart (margin {:.3f} m + braking and age {:.3f} m)",
+          a.name, part_a, remote_names_[t.b - local], part_b, remote_age_s_[t.b - local] * 1e3,
+          t.distance_m, model_.collision_margin_m, t.limit_m - model_.collision_margin_m);
     } else {
       const Robot& b = *robots_[t.b];
       const RobotCapsules& cb = world_->robot(t.b);
@@ -588,8 +646,35 @@ void Cell::check_collisions() noexcept {
     }
     const std::string_view why(message_.data());
     a.manipulator->generator().request_stop(why);
-    if (!t.solid) robots_[t.b]->manipulator->generator().request_stop(why);
+    if (!t.solid && t.b < local) robots_[t.b]->manipulator->generator().request_stop(why);
     collision_stops_.fetch_add(1, std::memory_order_acq_rel);
+  }
+}
+
+void Cell::set_remote_source(const RemoteRobotSource* source) {
+  if (started_) throw rtc::SessionError("set_remote_source: only before start()");
+  remote_source_ = source;
+}
+
+double Cell::remote_allowance_m(std::size_t remote, double age_s) const noexcept {
+  if (remote >= remote_point_speed_m_per_s_.size() || !(age_s > 0.0)) return 0.0;
+  // Beyond 10 m it stops everything near anyway; the cap keeps the sums finite.
+  return std::min(remote_point_speed_m_per_s_[remote] * age_s, 10.0);
+}
+
+void Cell::place_remote_robots(std::uint32_t tick) noexcept {
+  const std::size_t local = robots_.size();
+  // Never heard of: anywhere it could have gone since the cell started.
+  const double since_start_s =
+      static_cast<double>(tick) * std::chrono::duration<double>(group_->period()).count();
+  for (std::size_t k = 0; k < remote_names_.size(); ++k) {
+    kin::JointVector q;
+    double age = since_start_s;
+    if (remote_source_ != nullptr && remote_source_->latest(k, q, age)) {
+      world_->set_configuration(local + k, q);
+    }
+    remote_age_s_[k] = age;
+    world_->set_allowance(local + k, remote_allowance_m(k, age));
   }
 }
 

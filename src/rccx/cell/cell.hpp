@@ -78,6 +78,22 @@ struct CellOptions {
   bool one_thread = false;
   /// Real time only: rtc::SessionOptions::spin_before_tick.
   std::chrono::nanoseconds spin_before_tick{0};
+  /// The robots this process runs (names of the model's robots); empty: all of them. The
+  /// others are served by other processes (net::RobotServer): they are not simulated or
+  /// controlled here, but stay in the collision check, placed from their newest state
+  /// (Cell::set_remote_source) with the margin grown by its age.
+  std::vector<std::string> local_robots;
+};
+
+/// Where the robots of other processes are read from (the network layer's newest states), for
+/// the collision check. Called by the control task after every tick: noexcept, no lock, no
+/// allocation, no wait.
+class RemoteRobotSource {
+ public:
+  virtual ~RemoteRobotSource() = default;
+  /// Remote robot `remote` (an index of Cell::remote_names()): its newest commanded joints
+  /// (rad / m) and their age now (s). False when none has come yet.
+  virtual bool latest(std::size_t remote, kin::JointVector& q, double& age_s) const noexcept = 0;
 };
 
 /// Motions of several robots that start in the same sample (Cell::together).
@@ -127,13 +143,26 @@ class Cell {
   /// The simulated hardware below a robot's driver (a servo arm, or the Microbo's RCU), for
   /// tests that push or fault it between samples of simulated time.
   [[nodiscard]] rtc::SimulatedHardware& hardware(std::string_view name);
+  /// The robots run in this process (all of the model's unless CellOptions::local_robots).
   [[nodiscard]] std::vector<std::string> robot_names() const;
+  /// The model's robots run by other processes (CellOptions::local_robots), in model order.
+  [[nodiscard]] const std::vector<std::string>& remote_names() const noexcept {
+    return remote_names_;
+  }
+  /// Where the remote robots' states come from (kept by the caller while the cell runs);
+  /// before start() only. Without one, a remote robot stays at its ready pose with a margin
+  /// that grows with the time since start: it soon stops any robot that approaches it.
+  void set_remote_source(const RemoteRobotSource* source);
+  /// How far any point of a remote robot may have moved in `age_s` (s): the allowance its
+  /// capsules get in the collision check (its joints' top speeds times their levers), m.
+  [[nodiscard]] double remote_allowance_m(std::size_t remote, double age_s) const noexcept;
   /// Closes every robot's session, its RCCX_LOG log put in place (one file a robot, named by its
   /// name in the cell). True when every log is whole (or there is none); a lost one (a full
   /// disk, an I/O error) is said on stderr as "<program>: robot <name>'s sample log is lost: ..."
   /// so that a program's exit code can check it: `return cell.finish_logs("demo") ? 0 : 1;`.
   bool finish_logs(std::string_view program);
-  /// The index of a robot in the model (the order of the cell file); throws like robot().
+  /// The index of a robot among those run here (the model's order, remote robots left out);
+  /// throws like robot().
   [[nodiscard]] std::size_t index(std::string_view name) const;
   [[nodiscard]] const CellModel& model() const noexcept { return model_; }
   [[nodiscard]] rtc::SessionGroup& group() noexcept { return *group_; }
@@ -237,6 +266,7 @@ class Cell {
  private:
   struct Robot {
     std::string name;
+    std::size_t model_index = 0;  ///< in model_.robots
     rtc::SimulatedHardware hardware;
     rtc::Session* session = nullptr;
     std::unique_ptr<rccl::Manipulator> manipulator;
@@ -274,6 +304,9 @@ class Cell {
   [[nodiscard]] static double braking_fast(const Robot& r, const kin::JointVector& q0,
                                            const kin::JointVector& q1) noexcept;
   void check_collisions() noexcept;
+  /// Places the remote robots in the collision world from their newest states, each with the
+  /// allowance its state's age calls for.
+  void place_remote_robots(std::uint32_t tick) noexcept;
   /// Throws CellFileError when a robot's ready pose lies inside an object it may not touch.
   void check_clear_at_start() const;
   void publish_ledgers() noexcept;
@@ -282,6 +315,14 @@ class Cell {
   CellOptions options_;
   // Declared before the group: the cycle hook uses them until the group's tasks stop.
   std::vector<std::unique_ptr<Robot>> robots_;
+  /// Remote robots: their names, model indices and point-speed bounds (m/s: a point of the
+  /// arm moves at most this fast at the joints' top speeds); their collision-world indices
+  /// follow the local robots'.
+  std::vector<std::string> remote_names_;
+  std::vector<std::size_t> remote_model_index_;
+  std::vector<double> remote_point_speed_m_per_s_;
+  const RemoteRobotSource* remote_source_ = nullptr;
+  std::vector<double> remote_age_s_;  ///< control task: each remote state's age at the last tick
   /// Each robot's generator, side by side, so that the tick's last pass can fetch the next
   /// robots' ahead of use.
   std::vector<const rccl::TrajectoryGenerator*> generators_;
