@@ -137,34 +137,6 @@ void Cell::check_clear_at_start() const {
   }
 }
 
-std::uint64_t Cell::objects(const std::vector<std::string>& names) const {
-  std::uint64_t bits = 0;
-  for (const std::string& name : names) {
-    std::size_t k = 0;
-    while (k < model_.objects.size() && model_.objects[k].name != name) ++k;
-    if (k == model_.objects.size()) {
-      std::vector<std::string> known;
-      for (const CellObject& o : model_.objects) known.push_back(o.name);
-      throw std::invalid_argument(
-          fmt::format("cell {}: no object \"{}\"; its objects: {}", model_.name, name,
-                      known.empty() ? "none" : fmt::format("{}", fmt::join(known, ", "))));
-    }
-    if (k >= 64) {
-      throw std::invalid_argument(fmt::format(
-          "cell {}: object \"{}\" is number {}; a motion may touch only the first 64 objects",
-          model_.name, name, k + 1));
-    }
-    bits |= std::uint64_t{1} << k;
-  }
-  return bits;
-}
-
-rccl::StartWhen Cell::touching(const std::vector<std::string>& names) const {
-  rccl::StartWhen w;
-  w.touch = objects(names);
-  return w;
-}
-
 namespace {
 
 /// A robot's capsules (whole arm, shapes, tool), mounted on its object if it has one.
@@ -296,12 +268,6 @@ rccl::EventGate Cell::event(std::string_view robot, const rccl::Event& e) {
   rccl::EventGate g = r.manipulator->gate(e);  // resolves completed() to a motion id
   g.ledger = &r.ledger;
   return g;
-}
-
-rccl::StartWhen Cell::after(std::string_view robot, const rccl::Event& e) {
-  rccl::StartWhen w;
-  w.after.push_back(event(robot, e));
-  return w;
 }
 
 Together Cell::together(const std::vector<std::string>& robots, bool end_together) {
@@ -452,42 +418,10 @@ bool Cell::finish_logs(std::string_view program) {
   return whole;
 }
 
-const math::Transform& Cell::base(std::string_view name) const {
-  return model_.robots[find(name).model_index].base;
-}
-
-math::Transform Cell::world_to_base(std::string_view name,
-                                    const math::Transform& world_pose) const {
-  return find(name).base_inverse * world_pose;
-}
-
 ToolSample Cell::tool_sample(std::string_view name) const {
   ToolSample s;
   find(name).published.load(s);
   return s;
-}
-
-rccl::TransformPtr Cell::tool_transform(std::string_view robot) const {
-  const Robot& r = find(robot);
-  return rccl::constant(r.name + "_TOOL", r.tool);
-}
-
-rccl::TransformPtr Cell::base_inv_transform(std::string_view robot) const {
-  const Robot& r = find(robot);
-  return rccl::constant(r.name + "_BASE_INV", r.base_inverse);
-}
-
-rccl::PositionPtr Cell::world_goal(std::string_view robot, std::string name,
-                                   const std::vector<rccl::TransformPtr>& world) const {
-  std::vector<rccl::TransformPtr> rhs{base_inv_transform(robot)};
-  rhs.insert(rhs.end(), world.begin(), world.end());
-  return rccl::Position::make(std::move(name), {rccl::t6(), tool_transform(robot)}, rhs);
-}
-
-rccl::PositionPtr Cell::world_goal(std::string_view robot, std::string name,
-                                   const math::Transform& world_pose) const {
-  auto goal = rccl::constant(name, world_pose);
-  return world_goal(robot, std::move(name), {std::move(goal)});
 }
 
 rccl::TransformPtr Cell::tool_frame(std::string_view leader) const {
@@ -508,27 +442,6 @@ rccl::TransformPtr Cell::tool_frame(std::string_view leader) const {
   });
   t->set_reference("frame:" + r->name);  // a serve process resolves it by the robot's name
   return t;
-}
-
-rccl::TransformPtr Cell::in_base_of(std::string_view robot,
-                                    const rccl::TransformPtr& world_transform) const {
-  const Robot& r = find(robot);
-  const std::string name = world_transform->name() + "_in_" + r.name;
-  switch (world_transform->kind()) {
-    case rccl::TransformKind::constant:
-      return rccl::constant(name, r.base_inverse * world_transform->value());
-    case rccl::TransformKind::functional:
-      return rccl::functional(
-          name, [b = r.base_inverse, t = world_transform](const rccl::SampleContext& ctx) {
-            return b * t->value_now(ctx);
-          });
-    case rccl::TransformKind::hold:
-    case rccl::TransformKind::t6:
-      break;
-  }
-  throw std::invalid_argument(fmt::format(
-      "in_base_of({}, {}): a {} transform cannot be re-expressed; use a constant or functional one",
-      robot, world_transform->name(), rccl::to_string(world_transform->kind())));
 }
 
 void Cell::set_cycle_observer(std::function<void(std::uint32_t)> observer) {

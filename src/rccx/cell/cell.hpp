@@ -53,6 +53,7 @@
 #include "rccx/cell/cell_model.hpp"
 #include "rccx/cell/collision.hpp"
 #include "rccx/cell/seqlock.hpp"
+#include "rccx/cell/workcell.hpp"
 #include "rccx/rccl/manipulator.hpp"
 #include "rccx/rccl/transforms.hpp"
 #include "rccx/rtc/session.hpp"
@@ -115,7 +116,7 @@ struct ToolSample {
   double t_s = 0.0;                   ///< the time the setpoint is for, s
 };
 
-class Cell {
+class Cell : public Workcell {
  public:
   /// Builds every robot (simulated hardware, driver, session of the group, manipulator).
   /// Throws CellFileError for an invalid model, std::invalid_argument for a robot that cannot
@@ -123,14 +124,14 @@ class Cell {
   explicit Cell(CellModel model, CellOptions options = {});
   static std::unique_ptr<Cell> load(const std::filesystem::path& path, CellOptions options = {});
   /// Stops every robot's control, then the group's tasks.
-  ~Cell();
+  ~Cell() override;
   Cell(const Cell&) = delete;
   Cell& operator=(const Cell&) = delete;
 
   /// Starts the group's tasks and every robot's trajectory generator (rccl_control).
-  void start();
+  void start() override;
   /// Lets `d` pass for the whole cell (simulated time: runs those ticks).
-  void wait_for(std::chrono::nanoseconds d);
+  void wait_for(std::chrono::nanoseconds d) override;
   [[deprecated("waitfor waits for events; let time pass with wait_for(duration)")]] void waitfor(
       std::chrono::nanoseconds d) {
     wait_for(d);
@@ -138,13 +139,13 @@ class Cell {
 
   /// A robot's motion API. Throws std::invalid_argument naming the cell's robots for an
   /// unknown name.
-  [[nodiscard]] rccl::Manipulator& robot(std::string_view name);
+  [[nodiscard]] rccl::Manipulator& robot(std::string_view name) override;
   [[nodiscard]] rtc::Session& session(std::string_view name);
   /// The simulated hardware below a robot's driver (a servo arm, or the Microbo's RCU), for
   /// tests that push or fault it between samples of simulated time.
   [[nodiscard]] rtc::SimulatedHardware& hardware(std::string_view name);
   /// The robots run in this process (all of the model's unless CellOptions::local_robots).
-  [[nodiscard]] std::vector<std::string> robot_names() const;
+  [[nodiscard]] std::vector<std::string> robot_names() const override;
   /// The model's robots run by other processes (CellOptions::local_robots), in model order.
   [[nodiscard]] const std::vector<std::string>& remote_names() const noexcept {
     return remote_names_;
@@ -164,38 +165,15 @@ class Cell {
   /// The index of a robot among those run here (the model's order, remote robots left out);
   /// throws like robot().
   [[nodiscard]] std::size_t index(std::string_view name) const;
-  [[nodiscard]] const CellModel& model() const noexcept { return model_; }
+  [[nodiscard]] const CellModel& model() const noexcept override { return model_; }
   [[nodiscard]] rtc::SessionGroup& group() noexcept { return *group_; }
 
   // --- Frames across robots ------------------------------------------------------------------
-  /// world <- the robot's base frame, m.
-  [[nodiscard]] const math::Transform& base(std::string_view name) const;
-  /// A pose given in the world expressed in the robot's base frame: base^-1 world_pose.
-  [[nodiscard]] math::Transform world_to_base(std::string_view name,
-                                              const math::Transform& world_pose) const;
   /// A functional transform: `leader`'s commanded T6 TOOL in the world (its cell tool, or T6
   /// without one), extrapolated to the sample's time. Before its first setpoint: its ready pose.
-  [[nodiscard]] rccl::TransformPtr tool_frame(std::string_view leader) const;
-  /// A world-frame transform in `robot`'s base frame (base^-1 T): constant for a constant T,
-  /// functional for a functional one. Throws std::invalid_argument for hold and T6.
-  [[nodiscard]] rccl::TransformPtr in_base_of(std::string_view robot,
-                                              const rccl::TransformPtr& world_transform) const;
+  [[nodiscard]] rccl::TransformPtr tool_frame(std::string_view leader) const override;
   /// The last published tool frame of a robot (any thread).
   [[nodiscard]] ToolSample tool_sample(std::string_view name) const;
-  /// The robot's cell tool, T6 <- tool (m; identity without one), as a constant transform
-  /// "<robot>_TOOL" (C's mnp_tool).
-  [[nodiscard]] rccl::TransformPtr tool_transform(std::string_view robot) const;
-  /// The robot's base <- world (its base transform inverted) as a constant transform
-  /// "<robot>_BASE_INV" (C's mnp_base_inv).
-  [[nodiscard]] rccl::TransformPtr base_inv_transform(std::string_view robot) const;
-  /// A goal given in the world for the robot's tool: `T6 TOOL = BASE_INV GOAL...`, with
-  /// `world` the goal's product in the world frame (any transforms: another robot's
-  /// tool_frame, a hold, ...), or one world pose (m) as the constant `name`:
-  /// `microbo.move(cell.world_goal("microbo", "PAD", pad_in_world))`.
-  [[nodiscard]] rccl::PositionPtr world_goal(std::string_view robot, std::string name,
-                                             const std::vector<rccl::TransformPtr>& world) const;
-  [[nodiscard]] rccl::PositionPtr world_goal(std::string_view robot, std::string name,
-                                             const math::Transform& world_pose) const;
 
   // --- Synchronisation (Multi-RCCL) ----------------------------------------------------------
   /// An event of `robot`'s motions, for another robot's motion to wait for (StartWhen::after,
@@ -203,10 +181,7 @@ class Cell {
   /// every tick: a motion waiting on it starts at its first sample after the tick the event
   /// happened in, whatever the robots' order. Event::completed() means the last motion `robot`
   /// has queued so far. Throws like robot(); rccl::MotionError for a position's end.
-  [[nodiscard]] rccl::EventGate event(std::string_view robot, const rccl::Event& e);
-  /// What move() / dwell() take to start once `robot`'s event has happened:
-  /// `microbo.move(p, cell.after("puma", m.end()))`.
-  [[nodiscard]] rccl::StartWhen after(std::string_view robot, const rccl::Event& e);
+  [[nodiscard]] rccl::EventGate event(std::string_view robot, const rccl::Event& e) override;
   /// A joint start: one motion of each of `robots` (each queued with Together::when) starts in
   /// the same sample, the first all of them are sampled in once every one is at rest and
   /// ready; with `end_together`, all end (come to rest) in the same sample too, the faster
@@ -218,7 +193,7 @@ class Cell {
   /// failed when a gate can no longer open (its motion failed or was cancelled, its robot's
   /// control ended); timeout; session_ended when no robot's control is running.
   rccl::WaitResult waitfor(const std::vector<rccl::EventGate>& gates,
-                           std::chrono::nanoseconds timeout = std::chrono::hours(24));
+                           std::chrono::nanoseconds timeout = std::chrono::hours(24)) override;
   [[deprecated("wait_for lets time pass; wait for events with waitfor(gates)")]] rccl::WaitResult
   wait_for(const std::vector<rccl::EventGate>& gates,
            std::chrono::nanoseconds timeout = std::chrono::hours(24)) {
@@ -254,14 +229,6 @@ class Cell {
   /// A robot's named capsules for the collision check: the cell file's shapes and, for a tool
   /// without a shape in T6, a capsule from T6's origin to the tool's, the last link's radius.
   static std::vector<RobotShape> shapes_of(const CellRobot& robot);
-
-  /// The objects (by name) a motion's tool may touch, for StartWhen::touch. Throws
-  /// std::invalid_argument naming the cell's objects for an unknown name, or for an object past the
-  /// 64th.
-  [[nodiscard]] std::uint64_t objects(const std::vector<std::string>& names) const;
-  /// What move() / dwell() take to let the motion's tool touch these objects:
-  /// `microbo.move(p, cell.touching({"board"}))`. Throws as objects().
-  [[nodiscard]] rccl::StartWhen touching(const std::vector<std::string>& names) const;
 
  private:
   struct Robot {

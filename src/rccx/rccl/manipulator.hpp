@@ -31,6 +31,7 @@
 #include <vector>
 
 #include "rccx/kinematics/kinematics.hpp"
+#include "rccx/rccl/arm.hpp"
 #include "rccx/rccl/force_control.hpp"
 #include "rccx/rccl/trajectory.hpp"
 #include "rccx/rtc/session.hpp"
@@ -48,35 +49,12 @@ class MotionError : public std::runtime_error {
 void check_guard(const ForceGuard& guard);
 void check_compliance(const Compliance& compliance);
 
-/// Something a program may wait for.
-struct Event {
-  enum class Kind : std::uint8_t { motion_start, motion_end, position_end, completed };
-  Kind kind = Kind::completed;
-  std::uint64_t id = 0;                ///< motion_start / motion_end
-  const Position* position = nullptr;  ///< position_end: every queued motion to it has ended
-};
-
-/// A queued motion.
-struct Motion {
-  std::uint64_t id = 0;
-  [[nodiscard]] Event start() const noexcept { return {Event::Kind::motion_start, id, nullptr}; }
-  [[nodiscard]] Event end() const noexcept { return {Event::Kind::motion_end, id, nullptr}; }
-};
-
-enum class WaitResult : std::uint8_t {
-  reached,        ///< the event happened
-  failed,         ///< the motion waited for failed or was cancelled (see failures())
-  timeout,        ///< the timeout passed first
-  session_ended,  ///< control ended (see the session's termination)
-};
-std::string_view to_string(WaitResult r) noexcept;
-
-class Manipulator {
+class Manipulator : public Arm {
  public:
   /// The arm of `session` (its driver's robot), with its own kinematics solver.
   explicit Manipulator(rtc::Session& session);
   /// Stops control when it was started here.
-  ~Manipulator();
+  ~Manipulator() override;
   Manipulator(const Manipulator&) = delete;
   Manipulator& operator=(const Manipulator&) = delete;
 
@@ -87,26 +65,26 @@ class Manipulator {
   rtc::Termination stop_control();
 
   // --- Settings for the motions queued from now on --------------------------------------------
-  void set_mode(Mode mode) noexcept { settings_.mode = mode; }
+  void set_mode(Mode mode) override { settings_.mode = mode; }
   /// setvel: tool translation (m/s) and rotation (rad/s) speeds, both > 0.
-  void set_velocity(double translation_m_per_s, double rotation_rad_per_s);
+  void set_velocity(double translation_m_per_s, double rotation_rad_per_s) override;
   /// settime: segment duration (s; 0 = from the speeds) and transition time (s, > 0).
-  void set_segment_time(double seconds);
-  void set_transition_time(double seconds);
+  void set_segment_time(double seconds) override;
+  void set_transition_time(double seconds) override;
   /// The configuration to reach the next goals in ("lun", "n" ...); empty keeps the present one.
-  void set_configuration(std::string_view name);
-  [[nodiscard]] const MotionSettings& settings() const noexcept { return settings_; }
+  void set_configuration(std::string_view name) override;
+  [[nodiscard]] const MotionSettings& settings() const noexcept override { return settings_; }
 
   // --- Force (a robot with a wrist sensor: How::force.present) --------------------------------
   /// The motions queued from now on end, as nextmove ends them, when the force the tool exerts
   /// passes the guard's threshold (ForceGuard: along a tool axis, or its magnitude); contact()
   /// then says where. ForceGuard{} (kind none) turns it off. Throws MotionError for a bad
   /// threshold or axis.
-  void set_guard(const ForceGuard& guard);
+  void set_guard(const ForceGuard& guard) override;
   /// RCCL's comply / lock for the motions queued from now on: the compliant tool axes yield by
   /// the admittance of `compliance`; Compliance{} locks them all again. Throws MotionError for
   /// a setting out of range.
-  void set_compliance(const Compliance& compliance);
+  void set_compliance(const Compliance& compliance) override;
   /// The tool's load for gravity compensation (force::ToolLoad: the sensor's bias, the tool's
   /// mass and centre of mass in T6; tool_calibration.hpp measures it), and the robot base's
   /// orientation in the world (gravity along world -z; identity: the base stands upright).
@@ -131,7 +109,7 @@ class Manipulator {
   /// cell::Cell::event) have happened, or with the others of a rendezvous; it then starts from rest
   /// (the motion before it comes to rest first unless its gates are open by then) and is cancelled
   /// with the reason when a gate cannot open.
-  Motion move(const PositionPtr& position, const StartWhen& when = {});
+  Motion move(const PositionPtr& position, const StartWhen& when = {}) override;
   /// Called by each move() that queued a motion (after it did; not by dwell), with the motion
   /// and its position, on the thread that called move() - never from the sample loop. What
   /// rccx::view::Server::attach shows the goals of the running equations with. One observer: a
@@ -139,44 +117,40 @@ class Manipulator {
   using MoveObserver = std::function<void(const Motion&, const PositionPtr&)>;
   void set_move_observer(MoveObserver observer) { move_observer_ = std::move(observer); }
   /// RCCL's stop(): stay where the previous motion ends for `seconds` (gated as move()).
-  Motion dwell(double seconds, const StartWhen& when = {});
+  Motion dwell(double seconds, const StartWhen& when = {}) override;
   /// Stops smoothly where the arm is and cancels everything queued.
-  void halt();
+  void halt() override;
   /// Zero gravity ("marsh"): on, the generator stops commanding and the joints follow a push
   /// and stay; off, the generator starts again at rest where the arm was left. Only with
   /// nothing queued or moving (MotionError otherwise). Takes effect at the next sample.
   void set_zero_gravity(bool on);
   [[nodiscard]] bool zero_gravity() const noexcept { return zero_gravity_; }
   /// Closes (true) or opens the hand, at the next sample.
-  void set_hand(bool closed) noexcept;
+  void set_hand(bool closed) noexcept override;
   /// A joint controller setting (the Microbo's, e.g. Setting::examine to read its motor
   /// parameters into How), sent with the next sample.
   void send_setting(const rtc::SettingChg& setting) noexcept { setting_request_.store(setting); }
   /// The robot's park position (its ready pose, in joints).
-  [[nodiscard]] const PositionPtr& park() const noexcept { return park_; }
+  [[nodiscard]] const PositionPtr& park() const noexcept override { return park_; }
 
   // --- Synchronisation --------------------------------------------------------------------------
-  [[nodiscard]] static Event completed() noexcept { return {}; }
-  [[nodiscard]] static Event ended(const PositionPtr& p) noexcept {
-    return {Event::Kind::position_end, 0, p.get()};
-  }
   /// Waits for `event` (in simulated time: runs the samples until then).
   WaitResult waitfor(const Event& event,
-                     std::chrono::nanoseconds timeout = std::chrono::hours(24 * 365));
+                     std::chrono::nanoseconds timeout = std::chrono::hours(24 * 365)) override;
   [[deprecated("wait_for lets time pass; wait for an event with waitfor(event)")]] WaitResult
   wait_for(const Event& event, std::chrono::nanoseconds timeout = std::chrono::hours(24 * 365)) {
     return waitfor(event, timeout);
   }
   /// Lets `d` pass (the session's wait_for: in simulated time, runs those samples). Returns
   /// the session's termination if control ended meanwhile, an empty one otherwise.
-  rtc::Termination wait_for(std::chrono::nanoseconds d);
+  rtc::Termination wait_for(std::chrono::nanoseconds d) override;
   [[deprecated(
       "waitfor waits for an event; let time pass with wait_for(duration)")]] rtc::Termination
   waitfor(std::chrono::nanoseconds d) {
     return wait_for(d);
   }
   /// True when `event` has happened.
-  [[nodiscard]] bool happened(const Event& event) const noexcept;
+  [[nodiscard]] bool happened(const Event& event) const noexcept override;
   /// An event of this arm as another arm's motion may wait for it (StartWhen::after), read
   /// from the generator as it runs: a motion of another robot stepped later in the same tick
   /// sees it in that tick. (A cell's Cell::event reads a copy made after each tick instead, so
@@ -186,17 +160,17 @@ class Manipulator {
 
   // --- What happened ----------------------------------------------------------------------------
   /// Failures and cancellations so far (collected from the generator's events).
-  [[nodiscard]] const std::vector<MotionEvent>& failures();
+  [[nodiscard]] const std::vector<MotionEvent>& failures() override;
   /// Every event the generator sent since the last call (started, ended, failed, cancelled).
-  std::vector<MotionEvent> take_events();
+  std::vector<MotionEvent> take_events() override;
   /// How motion `m` followed its path (once it has ended).
-  [[nodiscard]] SegmentReport report(const Motion& m) const noexcept {
+  [[nodiscard]] SegmentReport report(const Motion& m) const noexcept override {
     return generator_->report(m.id);
   }
-  [[nodiscard]] std::uint64_t last_queued() const noexcept { return next_id_ - 1; }
+  [[nodiscard]] std::uint64_t last_queued() const noexcept override { return next_id_ - 1; }
 
   [[nodiscard]] rtc::Session& session() noexcept { return session_; }
-  [[nodiscard]] const kin::Kinematics& kinematics() const noexcept { return *kinematics_; }
+  [[nodiscard]] const kin::Kinematics& kinematics() const noexcept override { return *kinematics_; }
   [[nodiscard]] TrajectoryGenerator& generator() noexcept { return *generator_; }
 
  private:
