@@ -43,10 +43,9 @@ int run_serve(const ServeArgs& args) {
     const std::string near = nearest(name, known);
     std::string list;
     for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
-    throw BadArgument{fmt::format("--robots: cell {} has no robot \"{}\"{}; its robots are: {}",
-                                  model.name, name,
-                                  near.empty() ? "" : fmt::format(" (did you mean {}?)", near),
-                                  list)};
+    throw BadArgument{
+        fmt::format("--robots: cell {} has no robot \"{}\"{}; its robots are: {}", model.name, name,
+                    near.empty() ? "" : fmt::format(" (did you mean {}?)", near), list)};
   }
   if (args.secure.empty() != args.identity.empty()) {
     throw BadArgument{"--secure DIR and --identity NAME go together (rccx certs init DIR)"};
@@ -75,9 +74,8 @@ int run_serve(const ServeArgs& args) {
   }
   fmt::print("rccx serve: serving (stop with Ctrl-C or SIGTERM)\n");
   std::fflush(stdout);
-  const auto until = args.seconds.given()
-                         ? std::chrono::steady_clock::now() + args.seconds.value
-                         : std::chrono::steady_clock::time_point::max();
+  const auto until = args.seconds.given() ? std::chrono::steady_clock::now() + args.seconds.value
+                                          : std::chrono::steady_clock::time_point::max();
   while (io::stop_count() == 0 && std::chrono::steady_clock::now() < until &&
          server->failure().empty()) {
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
@@ -107,8 +105,7 @@ void add_serve_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--robots", args->robots, "The robots to serve, by their names in the cell")
       ->required()
       ->delimiter(',');
-  cmd->add_option("--domain", args->domain,
-                  "DDS domain, 0 .. 232 (default: $RCCX_DOMAIN, else 0)")
+  cmd->add_option("--domain", args->domain, "DDS domain, 0 .. 232 (default: $RCCX_DOMAIN, else 0)")
       ->check(CLI::Range(0, 232));
   cmd->add_option("--interface", args->interface,
                   "Network interface for DDS (lo, eth0, an address; default: "
@@ -123,8 +120,7 @@ void add_serve_command(CLI::App& app, int& exit_code) {
   add_duration_option(*cmd, "--claim-wait", args->claim_wait, std::chrono::milliseconds(10),
                       std::chrono::seconds(10),
                       "How long to listen for other processes' claims before and after claiming");
-  cmd->add_option("--secure", args->secure,
-                  "DDS Security: the directory `rccx certs init` made")
+  cmd->add_option("--secure", args->secure, "DDS Security: the directory `rccx certs init` made")
       ->check(not_empty());
   cmd->add_option("--identity", args->identity,
                   "This process's participant name in --secure's directory")
