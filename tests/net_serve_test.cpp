@@ -477,7 +477,11 @@ TEST(NetServe, ARobotFollowsAnotherProcesssRobotAndStopsWhenThatServeDies) {
   // The PUMA's tool over the board, pointing down; the Microbo's 60 mm to +x of it.
   puma.set_mode(rccl::Mode::joint);
   const rccl::Motion p1 = puma.move(cell.world_goal("puma", "OVER", tool_down(-0.03, 0.0, 0.19)));
-  ASSERT_EQ(puma.waitfor(p1.end(), 20s), rccl::WaitResult::reached);
+  ASSERT_EQ(puma.waitfor(p1.end(), 20s), rccl::WaitResult::reached) << [&] {
+    std::string s;
+    for (const auto& e : puma.failures()) s += std::string(e.message()) + "; ";
+    return s + "\nleader's serve: " + sp->err() + "\nfollower's serve: " + sm->err();
+  }();
   const auto offset = rccl::constant("BESIDE", math::Transform::translation(0.06, 0, 0));
   microbo.set_mode(rccl::Mode::joint);
   const rccl::Motion f1 =
@@ -487,6 +491,12 @@ TEST(NetServe, ARobotFollowsAnotherProcesssRobotAndStopsWhenThatServeDies) {
     for (const auto& e : microbo.failures()) s += std::string(e.message()) + "; ";
     return s;
   }();
+  // In Cartesian mode the Microbo goes on tracking its goal at rest (a joint motion's rest
+  // does not): the same goal again, the way a program follows a moving frame.
+  microbo.set_mode(rccl::Mode::cartesian);
+  const rccl::Motion f2 =
+      microbo.move(cell.world_goal("microbo", "FOLLOW", {cell.tool_frame("puma"), offset}));
+  ASSERT_EQ(microbo.waitfor(f2.end(), 20s), rccl::WaitResult::reached);
   // The PUMA moves 30 mm along y, slowly; the Microbo's tool tracks it.
   puma.set_mode(rccl::Mode::cartesian);
   puma.set_velocity(0.02, 0.3);
