@@ -502,12 +502,20 @@ TEST(NetServe, ARobotFollowsAnotherProcesssRobotAndStopsWhenThatServeDies) {
   puma.set_velocity(0.02, 0.3);
   const rccl::Motion p2 = puma.move(cell.world_goal("puma", "ASIDE", tool_down(-0.03, 0.03, 0.19)));
   double worst_mm = 0.0;
-  while (!puma.happened(p2.end())) {
+  rccl::WaitResult moved = rccl::WaitResult::timeout;
+  const auto until = std::chrono::steady_clock::now() + 20s;
+  while (std::chrono::steady_clock::now() < until &&
+         (moved = puma.waitfor(p2.end(), 20ms)) == rccl::WaitResult::timeout) {
     const net::RemoteState a = puma.state(), b = microbo.state();
     const math::Vec3 want = a.tool.pose.p + math::Vec3{0.06, 0, 0};
     worst_mm = std::max(worst_mm, (b.tool.pose.p - want).norm() * 1e3);
-    std::this_thread::sleep_for(20ms);
   }
+  ASSERT_EQ(moved, rccl::WaitResult::reached) << [&] {
+    std::string s;
+    for (const auto& e : puma.failures()) s += std::string(e.message()) + "; ";
+    for (const auto& e : microbo.failures()) s += std::string(e.message()) + "; ";
+    return s + "\nleader's serve: " + sp->err() + "\nfollower's serve: " + sm->err();
+  }();
   std::printf("the Microbo tracked the PUMA's tool (other process) within %.2f mm\n", worst_mm);
   EXPECT_LT(worst_mm, 5.0);
   // Now the PUMA moves back and its serve dies mid-motion: the Microbo stops smoothly.
