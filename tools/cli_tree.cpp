@@ -14,6 +14,7 @@
 #include "db_command.hpp"
 #include "kin_command.hpp"
 #include "plot_command.hpp"
+#include "serve_command.hpp"
 #include "rccx/io/spelling.hpp"
 #include "rcu_command.hpp"
 #include "rtc_commands.hpp"
@@ -367,6 +368,7 @@ std::unique_ptr<CLI::App> make_app(int& exit_code) {
   add_cell_command(*app, exit_code);
   add_view_command(*app, exit_code);
   add_plot_command(*app, exit_code);
+  add_serve_command(*app, exit_code);  // issue 29: robots served over DDS
   add_completion_command(*app, exit_code);
   verbs_take_parent_options(app.get(), true);
   return app;

@@ -85,6 +85,19 @@ bool MotionLedger::failed(std::uint64_t id) const noexcept {
   return false;
 }
 
+std::size_t MotionLedger::newest_failures(std::uint64_t* from, std::uint64_t* to,
+                                          std::size_t n) const noexcept {
+  const std::uint32_t count = failures_.load(std::memory_order_acquire);
+  std::size_t written = 0;
+  for (std::uint32_t k = count; k > 0 && written < n && written < kFailures; --k, ++written) {
+    const std::size_t i = (k - 1) % kFailures;
+    from[written] = failed_from_[i].load(std::memory_order_relaxed);
+    to[written] = failed_to_[i].load(std::memory_order_relaxed);
+  }
+  for (std::size_t i = written; i < n; ++i) from[i] = to[i] = 0;
+  return written;
+}
+
 GateAnswer MotionLedger::has_started(std::uint64_t id) const noexcept {
   if (id == 0) return GateAnswer::yes;  // nothing to wait for
   if (failed(id)) return GateAnswer::never;

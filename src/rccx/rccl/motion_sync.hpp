@@ -74,6 +74,9 @@ class MotionLedger {
   }
   /// True when motion `id` failed or was cancelled, as far as the ranges remembered tell.
   [[nodiscard]] bool failed(std::uint64_t id) const noexcept;
+  /// The newest failure ranges, newest first, into from[0 .. n) and to[0 .. n) (unused: 0);
+  /// returns how many were written. What a serve process sends in its RobotState.
+  std::size_t newest_failures(std::uint64_t* from, std::uint64_t* to, std::size_t n) const noexcept;
   [[nodiscard]] GateAnswer has_started(std::uint64_t id) const noexcept;
   [[nodiscard]] GateAnswer has_ended(std::uint64_t id) const noexcept;
   /// Changes so far (the copy's cue).

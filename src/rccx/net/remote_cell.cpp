@@ -1,0 +1,687 @@
+#include "rccx/net/remote_cell.hpp"
+
+#include <fmt/format.h>
+#include <pthread.h>
+#include <sched.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <set>
+#include <stdexcept>
+
+#include "rccx/io/console.hpp"
+#include "rccx/net/codec.hpp"
+
+namespace rccx::net {
+
+namespace {
+
+using namespace std::chrono_literals;
+
+double ms_of(std::int64_t ns) {
+  return static_cast<double>(ns) * 1e-6;
+}
+
+std::uint64_t random_instance() {
+  std::random_device rd;
+  const std::uint64_t v = (static_cast<std::uint64_t>(rd()) << 32) ^ rd();
+  return v == 0 ? 1 : v;
+}
+
+template <class T>
+int take(dds_entity_t reader, std::vector<T>& buf, std::vector<void*>& ptrs,
+         std::vector<dds_sample_info_t>& info) {
+  for (std::size_t i = 0; i < buf.size(); ++i) ptrs[i] = &buf[i];
+  const dds_return_t n = dds_take(reader, ptrs.data(), info.data(), buf.size(),
+                                  static_cast<std::uint32_t>(buf.size()));
+  return n < 0 ? 0 : static_cast<int>(n);
+}
+
+rccl::MotionEvent to_event(const rccx_net_MotionEvent& e) {
+  rccl::MotionEvent m;
+  m.kind = e.kind <= 3 ? static_cast<rccl::EventKind>(e.kind) : rccl::EventKind::failed;
+  m.id = e.motion;
+  m.t_s = e.t_s;
+  const std::string_view text = text_of(e.text);
+  const std::size_t n = std::min(text.size(), m.text.size() - 1);
+  std::copy_n(text.data(), n, m.text.data());
+  m.text[n] = '\0';
+  return m;
+}
+
+rccl::MotionEvent lost_event(std::uint64_t id, std::string_view why) {
+  rccl::MotionEvent m;
+  m.kind = rccl::EventKind::failed;
+  m.id = id;
+  const std::size_t n = std::min(why.size(), m.text.size() - 1);
+  std::copy_n(why.data(), n, m.text.data());
+  m.text[n] = '\0';
+  return m;
+}
+
+std::string robots_of(const cell::CellModel& model) {
+  std::string s;
+  for (const auto& r : model.robots) s += (s.empty() ? "" : ", ") + r.name;
+  return s;
+}
+
+/// The middleware thread decides that a peer is lost within the detection time, so it runs
+/// above ordinary threads when the process may (SCHED_FIFO at the lowest priority, below the
+/// control tasks'); otherwise as it is. It sleeps 1 ms every pass, so it cannot starve others.
+void raise_priority() noexcept {
+  sched_param p{};
+  p.sched_priority = sched_get_priority_min(SCHED_FIFO);
+  (void)pthread_setschedparam(pthread_self(), SCHED_FIFO, &p);
+}
+
+}  // namespace
+
+// --- RemoteArm -------------------------------------------------------------------------------
+
+RemoteArm::RemoteArm(RemoteCell& cell, const cell::CellRobot& robot)
+    : cell_(cell),
+      name_(robot.name),
+      kinematics_(kin::make_kinematics(robot.model)),
+      park_(rccl::Position::joints("park", robot.model.ready())),
+      mirror_(std::make_unique<RobotMirror>(robot.name)) {}
+
+void RemoteArm::set_velocity(double translation_m_per_s, double rotation_rad_per_s) {
+  if (!(translation_m_per_s > 0.0) || !(rotation_rad_per_s > 0.0) ||
+      !std::isfinite(translation_m_per_s) || !std::isfinite(rotation_rad_per_s)) {
+    throw rccl::MotionError(
+        fmt::format("set_velocity({}, {}): both speeds must be finite and > 0 (m/s, rad/s)",
+                    translation_m_per_s, rotation_rad_per_s));
+  }
+  settings_.translation_m_per_s = translation_m_per_s;
+  settings_.rotation_rad_per_s = rotation_rad_per_s;
+}
+
+void RemoteArm::set_segment_time(double seconds) {
+  if (!(seconds >= 0.0) || !std::isfinite(seconds)) {
+    throw rccl::MotionError(
+        fmt::format("set_segment_time({}): give s >= 0 (0: from the speeds)", seconds));
+  }
+  settings_.segment_time_s = seconds;
+}
+
+void RemoteArm::set_transition_time(double seconds) {
+  if (!(seconds > 0.0) || !std::isfinite(seconds)) {
+    throw rccl::MotionError(fmt::format("set_transition_time({}): give s > 0", seconds));
+  }
+  settings_.transition_time_s = seconds;
+}
+
+void RemoteArm::set_configuration(std::string_view name) {
+  if (name.empty()) {
+    settings_.configuration = -1;
+    return;
+  }
+  const auto names = kinematics_->configuration_names();
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    if (names[i] == name) {
+      settings_.configuration = static_cast<std::int16_t>(i);
+      return;
+    }
+  }
+  std::string known;
+  for (const auto n : names) known += (known.empty() ? "" : ", ") + std::string(n);
+  throw rccl::MotionError(fmt::format("robot {} has no configuration \"{}\"; it has: {}", name_,
+                                      name, known.empty() ? "none" : known));
+}
+
+void RemoteArm::set_guard(const rccl::ForceGuard& guard) {
+  rccl::check_guard(guard);
+  settings_.guard = guard;
+}
+
+void RemoteArm::set_compliance(const rccl::Compliance& compliance) {
+  rccl::check_compliance(compliance);
+  settings_.compliance = compliance;
+}
+
+rccx_net_MotionAck RemoteArm::request(rccx_net_MotionRequest& r) {
+  RemoteCell& c = cell_;
+  copy_to(r.robot, name_);
+  copy_to(r.program, c.participant_name_);
+  r.program_instance = c.instance_;
+  r.request = next_request_++;
+  const auto send = [&] { check(dds_write(c.request_writer_.get(), &r), "a motion request"); };
+  {
+    std::lock_guard lock(c.mutex_);
+    if (!lost_.empty()) throw rccl::MotionError(lost_);
+  }
+  send();
+  const std::int64_t start = steady_ns();
+  std::int64_t resend = start + 200'000'000;
+  std::unique_lock lock(c.mutex_);
+  for (;;) {
+    for (auto it = c.acks_.begin(); it != c.acks_.end(); ++it) {
+      if (it->request != r.request || text_of(it->robot) != name_) continue;
+      const rccx_net_MotionAck ack = *it;
+      c.acks_.erase(it);
+      if (ack.result == static_cast<std::uint8_t>(AckResult::refused)) {
+        throw rccl::MotionError(std::string(text_of(ack.message)));
+      }
+      return ack;
+    }
+    if (!lost_.empty()) throw rccl::MotionError(lost_);
+    const std::int64_t now = steady_ns();
+    if (now - start > c.options_.answer_timeout.count()) {
+      throw rccl::MotionError(fmt::format(
+          "robot {}: its serve process {} did not answer request {} within {:.0f} ms (is it "
+          "running on domain {}?)",
+          name_, mirror_->participant(), r.request, ms_of(now - start), c.participant_->domain()));
+    }
+    if (now >= resend) {  // the same id again: executed once at most
+      lock.unlock();
+      send();
+      lock.lock();
+      resend = now + 200'000'000;
+    }
+    c.changed_.wait_for(lock, 2ms);
+  }
+}
+
+rccl::Motion RemoteArm::move(const rccl::PositionPtr& position, const rccl::StartWhen& when) {
+  if (!position) throw rccl::MotionError(fmt::format("robot {}: move(nullptr)", name_));
+  if (when.together) {
+    throw rccl::MotionError(
+        "a joint start (Cell::together) across processes is not supported yet: use gates "
+        "(cell.after(robot, event))");
+  }
+  if (when.after.size() > 4) {
+    throw rccl::MotionError("at most 4 gates a motion cross processes");
+  }
+  rccx_net_MotionRequest r{};
+  r.kind = static_cast<std::uint8_t>(RequestKind::move);
+  rccl::MotionSettings s = settings_;
+  s.may_touch = when.touch;
+  encode_settings(s, r);
+  try {
+    encode_position(*position, r);
+  } catch (const CodecError& e) {
+    throw rccl::MotionError(
+        fmt::format("robot {}: move({}): {}", name_, position->name(), e.what()));
+  }
+  for (std::size_t i = 0; i < when.after.size(); ++i) {
+    const rccl::EventGate& g = when.after[i];
+    if (g.ledger == nullptr) throw rccl::MotionError("a gate without a ledger");
+    copy_to(r.after[i].robot, g.ledger->robot());
+    r.after[i].kind = g.kind == rccl::EventGate::Kind::started ? 0 : 1;
+    r.after[i].motion = g.id;
+  }
+  r.gates = static_cast<std::uint8_t>(when.after.size());
+  const rccx_net_MotionAck ack = request(r);
+  last_queued_ = std::max(last_queued_, ack.motion);
+  position_last_[position.get()] = ack.motion;
+  return rccl::Motion{ack.motion};
+}
+
+rccl::Motion RemoteArm::dwell(double seconds, const rccl::StartWhen& when) {
+  if (when.together) throw rccl::MotionError("a joint start across processes: not supported yet");
+  rccx_net_MotionRequest r{};
+  r.kind = static_cast<std::uint8_t>(RequestKind::dwell);
+  rccl::MotionSettings s = settings_;
+  s.may_touch = when.touch;
+  encode_settings(s, r);
+  r.value = seconds;
+  for (std::size_t i = 0; i < when.after.size() && i < 4; ++i) {
+    copy_to(r.after[i].robot, when.after[i].ledger->robot());
+    r.after[i].kind = when.after[i].kind == rccl::EventGate::Kind::started ? 0 : 1;
+    r.after[i].motion = when.after[i].id;
+  }
+  r.gates = static_cast<std::uint8_t>(std::min<std::size_t>(when.after.size(), 4));
+  const rccx_net_MotionAck ack = request(r);
+  last_queued_ = std::max(last_queued_, ack.motion);
+  return rccl::Motion{ack.motion};
+}
+
+void RemoteArm::halt() {
+  rccx_net_MotionRequest r{};
+  r.kind = static_cast<std::uint8_t>(RequestKind::halt);
+  encode_settings(settings_, r);
+  (void)request(r);
+}
+
+void RemoteArm::nextmove() {
+  rccx_net_MotionRequest r{};
+  r.kind = static_cast<std::uint8_t>(RequestKind::nextmove);
+  encode_settings(settings_, r);
+  (void)request(r);
+}
+
+void RemoteArm::set_hand(bool closed) {
+  rccx_net_MotionRequest r{};
+  r.kind = static_cast<std::uint8_t>(RequestKind::hand);
+  encode_settings(settings_, r);
+  r.value = closed ? 1.0 : 0.0;
+  (void)request(r);
+}
+
+void RemoteArm::attach() {
+  rccx_net_MotionRequest r{};
+  r.kind = static_cast<std::uint8_t>(RequestKind::attach);
+  encode_settings(settings_, r);
+  const rccx_net_MotionAck ack = request(r);
+  last_queued_ = std::max(last_queued_, ack.motion);
+}
+
+rccl::GateAnswer RemoteArm::answer(const rccl::Event& e) const {
+  switch (e.kind) {
+    case rccl::Event::Kind::motion_start:
+      return mirror_->ledger.has_started(e.id);
+    case rccl::Event::Kind::motion_end:
+      return mirror_->ledger.has_ended(e.id);
+    case rccl::Event::Kind::completed:
+      return mirror_->ledger.has_ended(last_queued_);
+    case rccl::Event::Kind::position_end: {
+      const auto it = position_last_.find(e.position);
+      return mirror_->ledger.has_ended(it == position_last_.end() ? 0 : it->second);
+    }
+  }
+  return rccl::GateAnswer::never;
+}
+
+rccl::WaitResult RemoteArm::waitfor(const rccl::Event& event, std::chrono::nanoseconds timeout) {
+  const std::int64_t until = steady_ns() + std::min<std::int64_t>(timeout.count(), INT64_MAX / 4);
+  std::unique_lock lock(cell_.mutex_);
+  for (;;) {
+    switch (answer(event)) {
+      case rccl::GateAnswer::yes:
+        return rccl::WaitResult::reached;
+      case rccl::GateAnswer::never:
+        return rccl::WaitResult::failed;
+      case rccl::GateAnswer::not_yet:
+        break;
+    }
+    if (steady_ns() >= until) return rccl::WaitResult::timeout;
+    cell_.changed_.wait_for(lock, 2ms);
+  }
+}
+
+void RemoteArm::wait_for(std::chrono::nanoseconds d) {
+  std::this_thread::sleep_for(d);
+}
+
+bool RemoteArm::happened(const rccl::Event& event) const {
+  std::lock_guard lock(cell_.mutex_);
+  return answer(event) == rccl::GateAnswer::yes;
+}
+
+std::vector<rccl::MotionEvent> RemoteArm::failures() const {
+  std::lock_guard lock(cell_.mutex_);
+  return failures_;
+}
+
+std::vector<rccl::MotionEvent> RemoteArm::take_events() {
+  std::lock_guard lock(cell_.mutex_);
+  std::vector<rccl::MotionEvent> out;
+  out.swap(events_);
+  return out;
+}
+
+RemoteState RemoteArm::state() const {
+  std::lock_guard lock(cell_.mutex_);
+  if (!state_) throw rccl::MotionError(fmt::format("robot {}: no state received yet", name_));
+  const rccx_net_RobotState& s = *state_;
+  RemoteState out;
+  out.participant = text_of(s.participant);
+  out.instance = s.instance;
+  out.sample = s.sample;
+  out.t_s = s.t_s;
+  out.q_commanded = kin::JointVector(std::min<std::size_t>(s.dof, 8));
+  out.q_measured = kin::JointVector(std::min<std::size_t>(s.dof, 8));
+  for (std::size_t j = 0; j < out.q_commanded.size(); ++j) {
+    out.q_commanded[j] = s.q_commanded[j];
+    out.q_measured[j] = s.q_measured[j];
+  }
+  out.tool.pose = from_pose(s.tool);
+  out.tool.velocity_m_per_s = {s.velocity[0], s.velocity[1], s.velocity[2]};
+  out.tool.acceleration_m_per_s2 = {s.acceleration[0], s.acceleration[1], s.acceleration[2]};
+  out.tool.angular_velocity_rad_s = {s.angular_velocity[0], s.angular_velocity[1],
+                                     s.angular_velocity[2]};
+  out.tool.t_s = s.t_s;
+  out.status = static_cast<RobotStatus>(s.status);
+  out.terminate_code = s.terminate_code;
+  out.termination = text_of(s.termination);
+  out.running = s.running;
+  out.queued = s.queued;
+  out.started_upto = s.started_upto;
+  out.ended_upto = s.ended_upto;
+  out.control_ended = s.control_ended;
+  out.program = text_of(s.program);
+  out.age = std::chrono::nanoseconds(steady_ns() - state_received_ns_);
+  return out;
+}
+
+// --- FrameStream -----------------------------------------------------------------------------
+
+FrameStream::FrameStream(RemoteCell& cell, std::string name)
+    : cell_(cell),
+      name_(std::move(name)),
+      last_(std::make_shared<cell::SeqLock<math::Transform>>()) {
+  if (name_.empty() || name_.size() > 31) {
+    throw std::invalid_argument(fmt::format("stream name \"{}\": 1 .. 31 characters", name_));
+  }
+  transform_ = rccl::functional(name_, [last = last_](const rccl::SampleContext&) {
+    math::Transform t;
+    return last->load(t) ? t : math::Transform::identity();
+  });
+  transform_->set_reference("stream:" + name_);
+}
+
+void FrameStream::set(const math::Transform& pose, const math::Vec3& velocity_m_per_s,
+                      const math::Vec3& angular_velocity_rad_s) {
+  rccx_net_FrameSample s{};
+  copy_to(s.name, name_);
+  copy_to(s.program, cell_.participant_name_);
+  s.seq = ++seq_;
+  s.stamp_ns = wall_ns();
+  to_pose(pose, s.pose);
+  s.velocity[0] = velocity_m_per_s.x;
+  s.velocity[1] = velocity_m_per_s.y;
+  s.velocity[2] = velocity_m_per_s.z;
+  s.angular_velocity[0] = angular_velocity_rad_s.x;
+  s.angular_velocity[1] = angular_velocity_rad_s.y;
+  s.angular_velocity[2] = angular_velocity_rad_s.z;
+  last_->store(pose);
+  check(dds_write(cell_.frame_writer_.get(), &s), fmt::format("stream {}", name_));
+}
+
+// --- RemoteCell ------------------------------------------------------------------------------
+
+RemoteCell::RemoteCell(cell::CellModel model, NetOptions net, RemoteOptions options)
+    : model_(std::move(model)), net_(std::move(net)), options_(std::move(options)) {
+  participant_name_ = "program/" + host_and_pid();
+  instance_ = random_instance();
+  std::vector<std::string> names = options_.robots;
+  if (names.empty()) {
+    for (const auto& r : model_.robots) names.push_back(r.name);
+  }
+  for (const std::string& n : names) {
+    const cell::CellRobot* r = model_.find_robot(n);
+    if (r == nullptr) {
+      throw std::invalid_argument(fmt::format("cell {} has no robot \"{}\"; its robots are: {}",
+                                              model_.name, n, robots_of(model_)));
+    }
+    arms_.push_back(std::make_unique<RemoteArm>(*this, *r));
+  }
+  participant_ = std::make_unique<Participant>(net_);
+  hb_writer_ = participant_->writer(Topic::heartbeat);
+  request_writer_ = participant_->writer(Topic::request);
+  frame_writer_ = participant_->writer(Topic::frame);
+  state_reader_ = participant_->reader(Topic::state, net_.detection * 10);
+  ack_reader_ = participant_->reader(Topic::ack);
+  event_reader_ = participant_->reader(Topic::event);
+  thread_ = std::thread([this] { run(); });
+  // Every robot's state, and the request readers of their serve processes matched.
+  const std::int64_t until = steady_ns() + options_.wait_for_robots.count();
+  std::unique_lock lock(mutex_);
+  for (;;) {
+    std::set<std::string> serves;
+    const RemoteArm* missing = nullptr;
+    for (const auto& a : arms_) {
+      if (!a->state_) {
+        missing = a.get();
+        break;
+      }
+      serves.insert(std::string(text_of(a->state_->participant)));
+    }
+    dds_publication_matched_status_t st{};
+    (void)dds_get_publication_matched_status(request_writer_.get(), &st);
+    if (missing == nullptr && st.current_count >= serves.size()) break;
+    if (steady_ns() >= until) {
+      lock.unlock();
+      stop_.store(true);
+      thread_.join();
+      if (missing != nullptr) {
+        throw NetError(fmt::format(
+            "robot {} is not served: start `rccx serve --cell FILE --robots {}` (domain {}{})",
+            missing->name(), missing->name(), participant_->domain(),
+            net_.interface.empty() ? "" : ", interface " + net_.interface));
+      }
+      throw NetError("the serve processes' request readers did not match within the wait");
+    }
+    changed_.wait_for(lock, 5ms);
+  }
+  // A restarted program goes on from where the robots are: their queues' last motions.
+  for (auto& a : arms_) a->last_queued_ = a->state_->queued;
+}
+
+RemoteCell::~RemoteCell() {
+  stop_.store(true);
+  if (thread_.joinable()) thread_.join();
+}
+
+RemoteArm* RemoteCell::find(std::string_view name) noexcept {
+  for (auto& a : arms_) {
+    if (a->name() == name) return a.get();
+  }
+  return nullptr;
+}
+
+RemoteArm& RemoteCell::robot(std::string_view name) {
+  if (RemoteArm* a = find(name)) return *a;
+  std::string known;
+  for (const auto& a : arms_) known += (known.empty() ? "" : ", ") + a->name();
+  throw std::invalid_argument(fmt::format("no robot \"{}\" here; the robots are: {}", name, known));
+}
+
+std::vector<std::string> RemoteCell::robot_names() const {
+  std::vector<std::string> v;
+  for (const auto& a : arms_) v.push_back(a->name());
+  return v;
+}
+
+const cell::CellRobot& RemoteCell::model_robot(std::string_view name) const {
+  const cell::CellRobot* r = model_.find_robot(name);
+  if (r == nullptr) {
+    throw std::invalid_argument(fmt::format("cell {} has no robot \"{}\"; its robots are: {}",
+                                            model_.name, name, robots_of(model_)));
+  }
+  return *r;
+}
+
+rccl::TransformPtr RemoteCell::tool_frame(std::string_view leader) {
+  RemoteArm& a = robot(leader);
+  return remote_frame(a.name() + "_TOOL", "frame:" + a.name(), &a.mirror_->frame, net_.detection);
+}
+
+rccl::TransformPtr RemoteCell::tool_transform(std::string_view robot) const {
+  const cell::CellRobot& r = model_robot(robot);
+  return rccl::constant(r.name + "_TOOL", r.tool.value_or(math::Transform::identity()));
+}
+
+rccl::TransformPtr RemoteCell::base_inv_transform(std::string_view robot) const {
+  const cell::CellRobot& r = model_robot(robot);
+  return rccl::constant(r.name + "_BASE_INV", r.base.inverse());
+}
+
+rccl::PositionPtr RemoteCell::world_goal(std::string_view robot, std::string name,
+                                         const std::vector<rccl::TransformPtr>& world) const {
+  std::vector<rccl::TransformPtr> rhs{base_inv_transform(robot)};
+  rhs.insert(rhs.end(), world.begin(), world.end());
+  return rccl::Position::make(std::move(name), {rccl::t6(), tool_transform(robot)}, rhs);
+}
+
+rccl::PositionPtr RemoteCell::world_goal(std::string_view robot, std::string name,
+                                         const math::Transform& world_pose) const {
+  auto goal = rccl::constant(name, world_pose);
+  return world_goal(robot, std::move(name), {std::move(goal)});
+}
+
+rccl::TransformPtr RemoteCell::function(std::string name) const {
+  auto t = rccl::functional(name, [](const rccl::SampleContext&) {
+    return math::Transform::identity();  // only the serve process can evaluate it
+  });
+  t->set_reference("function:" + name);
+  return t;
+}
+
+FrameStream& RemoteCell::stream(std::string name) {
+  auto& s = streams_[name];
+  if (!s) s = std::make_unique<FrameStream>(*this, name);
+  return *s;
+}
+
+rccl::EventGate RemoteCell::event(std::string_view robot_name, const rccl::Event& e) {
+  RemoteArm& a = robot(robot_name);
+  rccl::EventGate g;
+  g.ledger = &a.mirror_->ledger;
+  switch (e.kind) {
+    case rccl::Event::Kind::motion_start:
+      g.kind = rccl::EventGate::Kind::started;
+      g.id = e.id;
+      break;
+    case rccl::Event::Kind::motion_end:
+      g.kind = rccl::EventGate::Kind::ended;
+      g.id = e.id;
+      break;
+    case rccl::Event::Kind::completed:
+      g.kind = rccl::EventGate::Kind::ended;
+      g.id = a.last_queued();
+      break;
+    case rccl::Event::Kind::position_end:
+      throw rccl::MotionError(
+          "a position's end cannot gate another robot; use the motion's end (m.end())");
+  }
+  return g;
+}
+
+rccl::StartWhen RemoteCell::after(std::string_view robot_name, const rccl::Event& e) {
+  rccl::StartWhen w;
+  w.after.push_back(event(robot_name, e));
+  return w;
+}
+
+rccl::WaitResult RemoteCell::waitfor(const std::vector<rccl::EventGate>& gates,
+                                     std::chrono::nanoseconds timeout) {
+  const std::int64_t until = steady_ns() + std::min<std::int64_t>(timeout.count(), INT64_MAX / 4);
+  std::unique_lock lock(mutex_);
+  for (;;) {
+    bool all = true;
+    for (const rccl::EventGate& g : gates) {
+      const rccl::GateAnswer a = g.answer();
+      if (a == rccl::GateAnswer::never) return rccl::WaitResult::failed;
+      if (a == rccl::GateAnswer::not_yet) all = false;
+    }
+    if (all) return rccl::WaitResult::reached;
+    if (steady_ns() >= until) return rccl::WaitResult::timeout;
+    changed_.wait_for(lock, 2ms);
+  }
+}
+
+void RemoteCell::wait_for(std::chrono::nanoseconds d) {
+  std::this_thread::sleep_for(d);
+}
+
+void RemoteCell::run() noexcept {
+  raise_priority();
+  while (!stop_.load()) {
+    try {
+      poll(steady_ns());
+    } catch (const std::exception& e) {
+      io::eprint("rccx program: the network thread: {}\n", e.what());
+    }
+    std::this_thread::sleep_for(1ms);
+  }
+}
+
+void RemoteCell::poll(std::int64_t now) {
+  if (now - last_heartbeat_ns_ >= net_.heartbeat.count()) {
+    rccx_net_Heartbeat hb{};
+    copy_to(hb.participant, participant_name_);
+    hb.role = static_cast<std::uint8_t>(Role::program);
+    hb.instance = instance_;
+    hb.seq = ++heartbeat_seq_;
+    hb.period_ns = net_.heartbeat.count();
+    hb.detection_ns = net_.detection.count();
+    std::string robots;
+    for (const auto& a : arms_) robots += (robots.empty() ? "" : ",") + a->name();
+    copy_to(hb.robots, robots);
+    check(dds_write(hb_writer_.get(), &hb), "a heartbeat");
+    last_heartbeat_ns_ = now;
+  }
+  bool changed = false;
+  {
+    std::vector<rccx_net_RobotState> buf(8);
+    std::vector<void*> ptrs(buf.size());
+    std::vector<dds_sample_info_t> info(buf.size());
+    for (;;) {
+      const int n = take(state_reader_.get(), buf, ptrs, info);
+      for (int i = 0; i < n; ++i) {
+        if (!info[i].valid_data) continue;
+        RemoteArm* a = find(text_of(buf[i].robot));
+        if (a == nullptr) continue;
+        std::lock_guard lock(mutex_);
+        const bool restarted = a->mirror_->apply(buf[i], now);
+        a->state_ = buf[i];
+        a->state_received_ns_ = now;
+        if (!a->lost_.empty() || restarted) {
+          io::eprint("rccx program: robot {} is served {}by {}\n", a->name(),
+                     restarted ? "by a new serve process: " : "again ",
+                     text_of(buf[i].participant));
+          a->lost_.clear();
+          a->mirror_->set_lost(false);
+        }
+        changed = true;
+      }
+      if (n < static_cast<int>(buf.size())) break;
+    }
+  }
+  {
+    std::vector<rccx_net_MotionAck> buf(8);
+    std::vector<void*> ptrs(buf.size());
+    std::vector<dds_sample_info_t> info(buf.size());
+    for (;;) {
+      const int n = take(ack_reader_.get(), buf, ptrs, info);
+      for (int i = 0; i < n; ++i) {
+        if (!info[i].valid_data || text_of(buf[i].program) != participant_name_) continue;
+        std::lock_guard lock(mutex_);
+        acks_.push_back(buf[i]);
+        if (acks_.size() > 1024) acks_.erase(acks_.begin());
+        changed = true;
+      }
+      if (n < static_cast<int>(buf.size())) break;
+    }
+  }
+  {
+    std::vector<rccx_net_MotionEvent> buf(16);
+    std::vector<void*> ptrs(buf.size());
+    std::vector<dds_sample_info_t> info(buf.size());
+    for (;;) {
+      const int n = take(event_reader_.get(), buf, ptrs, info);
+      for (int i = 0; i < n; ++i) {
+        if (!info[i].valid_data) continue;
+        RemoteArm* a = find(text_of(buf[i].robot));
+        if (a == nullptr) continue;
+        const rccl::MotionEvent e = to_event(buf[i]);
+        std::lock_guard lock(mutex_);
+        a->events_.push_back(e);
+        if (a->events_.size() > 4096) a->events_.erase(a->events_.begin());
+        if (e.kind == rccl::EventKind::failed || e.kind == rccl::EventKind::cancelled) {
+          a->failures_.push_back(e);
+        }
+        changed = true;
+      }
+      if (n < static_cast<int>(buf.size())) break;
+    }
+  }
+  // A robot whose serve process is silent for the detection time is lost.
+  for (auto& a : arms_) {
+    std::lock_guard lock(mutex_);
+    if (!a->state_ || !a->lost_.empty()) continue;
+    const std::int64_t silent = now - a->mirror_->received_ns();
+    if (silent <= net_.detection.count()) continue;
+    a->lost_ = fmt::format("robot {} lost: its serve process {} is silent for {:.0f} ms", a->name(),
+                           a->mirror_->participant(), ms_of(silent));
+    a->mirror_->set_lost(true);
+    a->failures_.push_back(lost_event(a->last_queued_, a->lost_));
+    io::eprint("rccx program: {}\n", a->lost_);
+    changed = true;
+  }
+  if (changed) changed_.notify_all();
+}
+
+}  // namespace rccx::net

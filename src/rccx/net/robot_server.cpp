@@ -1,0 +1,785 @@
+#include "rccx/net/robot_server.hpp"
+
+#include <fmt/format.h>
+#include <pthread.h>
+#include <sched.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <deque>
+#include <random>
+#include <set>
+#include <stdexcept>
+
+#include "rccx/io/console.hpp"
+#include "rccx/net/codec.hpp"
+#include "rccx/rtc/latest.hpp"
+
+namespace rccx::net {
+
+namespace {
+
+using namespace std::chrono_literals;
+
+/// What the control task hands the middleware thread after a tick (trivially copyable).
+struct Slot {
+  std::uint64_t sample = 0;
+  double t_s = 0.0;
+  std::uint8_t dof = 0;
+  double q[8]{};
+  cell::ToolSample tool;
+  std::uint64_t running = 0;
+  std::int64_t stamp_ns = 0;
+};
+
+std::uint64_t random_instance() {
+  std::random_device rd;
+  const std::uint64_t v = (static_cast<std::uint64_t>(rd()) << 32) ^ rd();
+  return v == 0 ? 1 : v;
+}
+
+double ms_of(std::int64_t ns) {
+  return static_cast<double>(ns) * 1e-6;
+}
+
+std::string join(const std::vector<std::string>& v) {
+  std::string s;
+  for (const auto& x : v) s += (s.empty() ? "" : ", ") + x;
+  return s;
+}
+
+/// Takes up to `n` samples of `reader` into `buf`; returns how many are valid data, in
+/// `info` order (invalid ones: instance state changes).
+template <class T>
+int take(dds_entity_t reader, std::vector<T>& buf, std::vector<void*>& ptrs,
+         std::vector<dds_sample_info_t>& info) {
+  for (std::size_t i = 0; i < buf.size(); ++i) ptrs[i] = &buf[i];
+  const dds_return_t n = dds_take(reader, ptrs.data(), info.data(), buf.size(),
+                                  static_cast<std::uint32_t>(buf.size()));
+  return n < 0 ? 0 : static_cast<int>(n);
+}
+
+/// The middleware thread decides that a peer is lost within the detection time, so it runs
+/// above ordinary threads when the process may (SCHED_FIFO at the lowest priority, below the
+/// control tasks'); otherwise as it is. It sleeps 1 ms every pass, so it cannot starve others.
+void raise_priority() noexcept {
+  sched_param p{};
+  p.sched_priority = sched_get_priority_min(SCHED_FIFO);
+  (void)pthread_setschedparam(pthread_self(), SCHED_FIFO, &p);
+}
+
+}  // namespace
+
+struct RobotServer::Local {
+  std::string name;
+  rccl::Manipulator* arm = nullptr;
+  const rccl::TrajectoryGenerator* gen = nullptr;
+  rtc::Session* session = nullptr;
+  double period_s = 0.0;
+  rtc::detail::Latest<Slot> latest;  ///< control task -> middleware thread
+  // Control task only.
+  double last_t_s = -1.0;
+  std::uint64_t samples = 0;
+  // Middleware thread only.
+  Slot slot;
+  bool have_slot = false;
+  std::int64_t written_ns = 0;  ///< steady, last state written
+  std::string program;          ///< attached program ("" none)
+  std::uint64_t program_instance = 0;
+  std::int64_t attached_ns = 0;
+  struct Origin {
+    std::string program;
+    std::uint64_t request = 0;
+  };
+  std::map<std::uint64_t, Origin> origin;  ///< motion id -> who asked (the newest 1024)
+  std::string halt_reason;
+  std::uint64_t halt_upto = 0;
+  std::set<std::string> follows;  ///< remote robots whose frame the last motion uses
+  std::set<std::string> streams;  ///< streams the last motion uses
+};
+
+struct RobotServer::Dedup {
+  std::uint64_t instance = 0;
+  std::uint64_t highest = 0;
+  std::deque<rccx_net_MotionAck> acks;  ///< the newest 256 answers
+};
+
+cell::CellModel served_model(const cell::CellModel& model, const std::vector<std::string>& robots) {
+  std::vector<std::string> names;
+  for (const auto& r : model.robots) names.push_back(r.name);
+  if (robots.empty()) {
+    throw std::invalid_argument(
+        fmt::format("no robot to serve: give --robots with some of {}", join(names)));
+  }
+  cell::CellModel out = model;
+  out.robots.clear();
+  std::set<std::string> seen;
+  for (const std::string& name : robots) {
+    const cell::CellRobot* r = model.find_robot(name);
+    if (r == nullptr) {
+      throw std::invalid_argument(fmt::format("cell {} has no robot \"{}\"; its robots are: {}",
+                                              model.name, name, join(names)));
+    }
+    if (!seen.insert(name).second) {
+      throw std::invalid_argument(fmt::format("robot {} is named twice", name));
+    }
+  }
+  for (const auto& r : model.robots) {  // the cell file's order
+    if (seen.count(r.name) != 0) out.robots.push_back(r);
+  }
+  return out;
+}
+
+RobotServer::RobotServer(cell::CellModel model, std::vector<std::string> robots,
+                         ServeOptions options)
+    : full_model_(std::move(model)), robot_names_(std::move(robots)), options_(std::move(options)) {
+  (void)served_model(full_model_, robot_names_);  // checks the names now
+  participant_name_ = "serve/" + host_and_pid();
+  instance_ = random_instance();
+}
+
+RobotServer::~RobotServer() {
+  stop();
+}
+
+void RobotServer::register_function(std::string name, rccl::TransformFunction function) {
+  if (started_) throw std::logic_error("register_function: only before start()");
+  if (name.empty() || name.size() > 31) {
+    throw std::invalid_argument(fmt::format("function name \"{}\": 1 .. 31 characters", name));
+  }
+  functions_[std::move(name)] = std::move(function);
+}
+
+std::string RobotServer::banner() const {
+  const bool secure = !options_.net.secure_dir.empty();
+  std::string interface = options_.net.interface;
+  if (interface.empty()) {
+    const char* env = std::getenv("RCCX_DDS_INTERFACE");
+    interface = env != nullptr && *env != '\0' ? env : "Cyclone's default";
+  }
+  return fmt::format(
+      "rccx serve: {} of cell {} as {}, DDS domain {}, interface {}, {}", join(robot_names_),
+      full_model_.name, participant_name_, domain_of(options_.net), interface,
+      secure ? fmt::format("secure (DDS Security, identity {})", options_.net.secure_identity)
+             : "plain DDS: anyone on the network can read and command these robots; use "
+               "--secure DIR for DDS Security");
+}
+
+std::string RobotServer::failure() const {
+  std::lock_guard lock(failure_mutex_);
+  return failure_;
+}
+
+RobotServer::Local* RobotServer::local(std::string_view robot) noexcept {
+  for (auto& l : locals_) {
+    if (l->name == robot) return l.get();
+  }
+  return nullptr;
+}
+
+// --- Claims ----------------------------------------------------------------------------------
+
+void RobotServer::claim() {
+  claim_reader_ = participant_->reader(Topic::claim);
+  claim_writer_ = participant_->writer(Topic::claim);
+  // Another live process's claims on our robots (a dead one's writer is gone: Cyclone drops its
+  // instances, and a claim whose writer is no longer matched does not count).
+  const auto others = [this] {
+    std::vector<rccx_net_Claim> found;
+    std::vector<rccx_net_Claim> buf(64);
+    std::vector<void*> ptrs(buf.size());
+    std::vector<dds_sample_info_t> info(buf.size());
+    for (std::size_t i = 0; i < buf.size(); ++i) ptrs[i] = &buf[i];
+    const dds_return_t n =
+        dds_read_mask(claim_reader_.get(), ptrs.data(), info.data(), buf.size(),
+                      static_cast<std::uint32_t>(buf.size()), DDS_ALIVE_INSTANCE_STATE);
+    for (int i = 0; i < n; ++i) {
+      if (!info[i].valid_data) continue;
+      const rccx_net_Claim& c = buf[i];
+      if (text_of(c.participant) == participant_name_) continue;
+      if (std::find(robot_names_.begin(), robot_names_.end(), text_of(c.robot)) ==
+          robot_names_.end()) {
+        continue;
+      }
+      dds_builtintopic_endpoint_t* w =
+          dds_get_matched_publication_data(claim_reader_.get(), info[i].publication_handle);
+      if (w == nullptr) continue;  // its writer is gone
+      dds_builtintopic_free_endpoint(w);
+      found.push_back(c);
+    }
+    return found;
+  };
+  const auto refuse = [this](const rccx_net_Claim& c, std::string_view how) {
+    return ClaimRefused(fmt::format(
+        "robot {} is served already by {} (host {}, pid {}){}: stop that process first, or "
+        "serve other robots (domain {})",
+        text_of(c.robot), text_of(c.participant), text_of(c.host), static_cast<long>(c.pid), how,
+        participant_->domain()));
+  };
+  std::this_thread::sleep_for(options_.claim_wait);
+  if (const auto held = others(); !held.empty()) throw refuse(held.front(), "");
+  const std::string host_pid = host_and_pid();
+  const std::string host = host_pid.substr(0, host_pid.rfind('/'));
+  const std::int64_t since = wall_ns();
+  for (const std::string& robot : robot_names_) {
+    rccx_net_Claim c{};
+    copy_to(c.robot, robot);
+    copy_to(c.participant, participant_name_);
+    c.instance = instance_;
+    c.since_ns = since;
+    copy_to(c.host, host);
+    c.pid = static_cast<std::int32_t>(getpid());
+    check(dds_write(claim_writer_.get(), &c), fmt::format("the claim on robot {}", robot));
+    claims_.push_back(c);
+  }
+  // A race: another process claimed at the same time. The earlier claim wins; at the same
+  // instant, the smaller participant name.
+  std::this_thread::sleep_for(options_.claim_wait);
+  for (const rccx_net_Claim& c : others()) {
+    const bool theirs_first =
+        c.since_ns < since ||
+        (c.since_ns == since && text_of(c.participant) < std::string_view(participant_name_));
+    if (theirs_first) {
+      release_claims();
+      throw refuse(c, ", which claimed it first while this process started");
+    }
+  }
+}
+
+void RobotServer::release_claims() noexcept {
+  for (const rccx_net_Claim& c : claims_) (void)dds_dispose(claim_writer_.get(), &c);
+  claims_.clear();
+}
+
+// --- Start and stop --------------------------------------------------------------------------
+
+void RobotServer::start() {
+  if (started_) return;
+  participant_ = std::make_unique<Participant>(options_.net);
+  claim();
+  try {
+    const std::chrono::nanoseconds deadline = options_.net.detection;  // offered
+    hb_writer_ = participant_->writer(Topic::heartbeat);
+    hb_reader_ = participant_->reader(Topic::heartbeat);
+    state_writer_ = participant_->writer(Topic::state, deadline);
+    // Requested: any writer's offer up to 10 detection times matches (rccx's own freshness
+    // check, not DDS's deadline, decides that a robot is lost).
+    state_reader_ = participant_->reader(Topic::state, deadline * 10);
+    request_reader_ = participant_->reader(Topic::request);
+    ack_writer_ = participant_->writer(Topic::ack);
+    event_writer_ = participant_->writer(Topic::event);
+    frame_reader_ = participant_->reader(Topic::frame);
+
+    cell::CellOptions co;
+    co.clock = rtc::ClockKind::real_time;
+    co.real_time_scheduling = options_.real_time_scheduling;
+    cell_ = std::make_unique<cell::Cell>(served_model(full_model_, robot_names_), co);
+    for (const std::string& name : cell_->robot_names()) {
+      auto l = std::make_unique<Local>();
+      l->name = name;
+      l->arm = &cell_->robot(name);
+      l->gen = &l->arm->generator();
+      l->session = &cell_->session(name);
+      l->period_s = std::chrono::duration<double>(l->session->period()).count();
+      locals_.push_back(std::move(l));
+    }
+    for (const auto& r : full_model_.robots) {
+      if (local(r.name) == nullptr) mirrors_[r.name] = std::make_unique<RobotMirror>(r.name);
+    }
+    cell_->set_cycle_observer([this](std::uint32_t) { on_cycle(); });
+    cell_->start();
+  } catch (...) {
+    release_claims();
+    throw;
+  }
+  started_ = true;
+  thread_ = std::thread([this] { run(); });
+}
+
+void RobotServer::stop() {
+  if (!started_ || stopped_) return;
+  stopped_ = true;
+  stop_.store(true);
+  if (thread_.joinable()) thread_.join();
+  release_claims();
+  cell_.reset();  // ends control
+}
+
+// --- The control task's part -----------------------------------------------------------------
+
+void RobotServer::on_cycle() noexcept {
+  try {
+    for (auto& lp : locals_) {
+      Local& l = *lp;
+      const double t = l.gen->last_setpoint_time_s();
+      const kin::JointVector& q = l.gen->last_setpoint();
+      if (q.empty() || t == l.last_t_s) continue;  // nothing new this tick
+      l.last_t_s = t;
+      Slot s;
+      s.sample = ++l.samples;
+      s.t_s = t;
+      s.dof = static_cast<std::uint8_t>(std::min<std::size_t>(q.size(), 8));
+      for (std::size_t j = 0; j < s.dof; ++j) s.q[j] = q[j];
+      s.tool = cell_->tool_sample(l.name);  // the seqlock: no lock, no allocation
+      s.running = l.gen->last_motion();
+      // The setpoint is for two periods after this sample (Manipulator's pipeline).
+      s.stamp_ns = wall_ns() + static_cast<std::int64_t>((t - s.tool.t_s) * 1e9) +
+                   static_cast<std::int64_t>(2.0 * l.period_s * 1e9);
+      l.latest.publish(s);
+    }
+  } catch (...) {  // tool_sample of a known robot does not throw
+  }
+}
+
+// --- The middleware thread -------------------------------------------------------------------
+
+void RobotServer::run() noexcept {
+  try {
+    if (options_.real_time_scheduling) raise_priority();
+    while (!stop_.load()) {
+      poll();
+      std::this_thread::sleep_for(1ms);
+    }
+    // Stopping: halt every robot, let them come to rest (bounded), say so in a last state.
+    for (auto& l : locals_) halt_with(*l, "the serve process is stopping: stopped smoothly");
+    const std::int64_t until = steady_ns() + 2'000'000'000;
+    while (steady_ns() < until) {
+      bool rest = true;
+      for (auto& l : locals_) {
+        if (l->gen->ledger().ended_upto() < l->arm->last_queued()) rest = false;
+      }
+      publish_events();
+      publish_states(steady_ns());
+      if (rest) break;
+      std::this_thread::sleep_for(1ms);
+    }
+    std::this_thread::sleep_for(100ms);  // the halt's last samples
+    publish_events();
+    publish_states(steady_ns(), true);
+  } catch (const std::exception& e) {
+    std::lock_guard lock(failure_mutex_);
+    failure_ = e.what();
+  }
+}
+
+void RobotServer::poll() {
+  const std::int64_t now = steady_ns();
+  read_heartbeats(now);
+  read_states(now);
+  read_frames(now);
+  read_requests(now);
+  publish_events();
+  publish_states(now);
+  if (now - last_heartbeat_ns_ >= options_.net.heartbeat.count()) {
+    rccx_net_Heartbeat hb{};
+    copy_to(hb.participant, participant_name_);
+    hb.role = static_cast<std::uint8_t>(Role::serve);
+    hb.instance = instance_;
+    hb.seq = ++heartbeat_seq_;
+    hb.period_ns = options_.net.heartbeat.count();
+    hb.detection_ns = options_.net.detection.count();
+    copy_to(hb.robots, join(robot_names_));
+    check(dds_write(hb_writer_.get(), &hb), "a heartbeat");
+    last_heartbeat_ns_ = now;
+  }
+  check_lost(now);
+}
+
+void RobotServer::read_heartbeats(std::int64_t now) {
+  std::vector<rccx_net_Heartbeat> buf(16);
+  std::vector<void*> ptrs(buf.size());
+  std::vector<dds_sample_info_t> info(buf.size());
+  for (;;) {
+    const int n = take(hb_reader_.get(), buf, ptrs, info);
+    for (int i = 0; i < n; ++i) {
+      if (!info[i].valid_data || buf[i].role != static_cast<std::uint8_t>(Role::program)) continue;
+      Program& p = programs_[std::string(text_of(buf[i].participant))];
+      p.instance = buf[i].instance;
+      p.seen_ns = now;
+    }
+    if (n < static_cast<int>(buf.size())) break;
+  }
+}
+
+void RobotServer::read_states(std::int64_t now) {
+  std::vector<rccx_net_RobotState> buf(8);
+  std::vector<void*> ptrs(buf.size());
+  std::vector<dds_sample_info_t> info(buf.size());
+  for (;;) {
+    const int n = take(state_reader_.get(), buf, ptrs, info);
+    for (int i = 0; i < n; ++i) {
+      if (!info[i].valid_data) continue;
+      const auto it = mirrors_.find(std::string(text_of(buf[i].robot)));
+      if (it == mirrors_.end()) continue;  // ours (or not of this cell)
+      RobotMirror& m = *it->second;
+      const bool was_lost = m.lost();
+      if (m.apply(buf[i], now) || was_lost) {
+        io::eprint("rccx serve: robot {} is served by {}{}\n", m.name(), m.participant(),
+                   was_lost ? " again" : " (a new instance)");
+      }
+      if (was_lost) m.set_lost(false);
+    }
+    if (n < static_cast<int>(buf.size())) break;
+  }
+}
+
+void RobotServer::read_frames(std::int64_t now) {
+  std::vector<rccx_net_FrameSample> buf(8);
+  std::vector<void*> ptrs(buf.size());
+  std::vector<dds_sample_info_t> info(buf.size());
+  for (;;) {
+    const int n = take(frame_reader_.get(), buf, ptrs, info);
+    for (int i = 0; i < n; ++i) {
+      if (!info[i].valid_data) continue;
+      auto& slot = streams_[std::string(text_of(buf[i].name))];
+      if (!slot) slot = std::make_unique<Stream>();
+      FrameState f;
+      f.pose = from_pose(buf[i].pose);
+      f.velocity_m_per_s = {buf[i].velocity[0], buf[i].velocity[1], buf[i].velocity[2]};
+      f.angular_velocity_rad_s = {buf[i].angular_velocity[0], buf[i].angular_velocity[1],
+                                  buf[i].angular_velocity[2]};
+      f.stamp_ns = buf[i].stamp_ns;
+      slot->frame.store(f);
+      slot->received_ns = now;
+      slot->lost = false;
+    }
+    if (n < static_cast<int>(buf.size())) break;
+  }
+}
+
+void RobotServer::read_requests(std::int64_t now) {
+  std::vector<rccx_net_MotionRequest> buf(4);
+  std::vector<void*> ptrs(buf.size());
+  std::vector<dds_sample_info_t> info(buf.size());
+  for (;;) {
+    const int n = take(request_reader_.get(), buf, ptrs, info);
+    for (int i = 0; i < n; ++i) {
+      if (info[i].valid_data) handle(buf[i], now);
+    }
+    if (n < static_cast<int>(buf.size())) break;
+  }
+}
+
+void RobotServer::handle(const rccx_net_MotionRequest& r, std::int64_t now) {
+  Local* l = local(text_of(r.robot));
+  if (l == nullptr) return;  // another process's robot
+  const std::string program(text_of(r.program));
+  auto& dp = dedup_[program + "|" + l->name];
+  if (!dp) dp = std::make_unique<Dedup>();
+  Dedup& d = *dp;
+  if (d.instance != r.program_instance) {  // a restarted program counts from 1 again
+    d = Dedup{};
+    d.instance = r.program_instance;
+  }
+  if (r.request <= d.highest) {
+    // Executed already: the same answer again, never the motion again.
+    rccx_net_MotionAck again{};
+    copy_to(again.robot, l->name);
+    copy_to(again.program, program);
+    again.request = r.request;
+    again.result = static_cast<std::uint8_t>(AckResult::duplicate);
+    copy_to(again.message, "request already executed: not executed again");
+    for (const auto& a : d.acks) {
+      if (a.request != r.request) continue;
+      again.motion = a.motion;
+      if (a.result == static_cast<std::uint8_t>(AckResult::refused)) again = a;
+    }
+    check(dds_write(ack_writer_.get(), &again), "an acknowledgement");
+    return;
+  }
+  d.highest = r.request;
+  // Any request attaches its program: from now on its loss stops this robot.
+  if (l->program != program || l->program_instance != r.program_instance) {
+    l->program = program;
+    l->program_instance = r.program_instance;
+    l->attached_ns = now;
+  }
+  rccx_net_MotionAck ack{};
+  copy_to(ack.robot, l->name);
+  copy_to(ack.program, program);
+  ack.request = r.request;
+  try {
+    execute(*l, r, ack);
+  } catch (const std::exception& e) {  // MotionError, EquationError, CodecError, ...
+    ack.result = static_cast<std::uint8_t>(AckResult::refused);
+    ack.motion = 0;
+    copy_to(ack.message, e.what());
+  }
+  if (ack.result == static_cast<std::uint8_t>(AckResult::accepted) && ack.motion != 0 &&
+      (r.kind == static_cast<std::uint8_t>(RequestKind::move) ||
+       r.kind == static_cast<std::uint8_t>(RequestKind::dwell))) {
+    l->origin[ack.motion] = {program, r.request};
+    while (l->origin.size() > 1024) l->origin.erase(l->origin.begin());
+  }
+  d.acks.push_back(ack);
+  while (d.acks.size() > 256) d.acks.pop_front();
+  check(dds_write(ack_writer_.get(), &ack), "an acknowledgement");
+}
+
+void RobotServer::execute(Local& l, const rccx_net_MotionRequest& r, rccx_net_MotionAck& ack) {
+  rccl::Manipulator& arm = *l.arm;
+  ack.result = static_cast<std::uint8_t>(AckResult::accepted);
+  const auto kind = static_cast<RequestKind>(r.kind);
+  switch (kind) {
+    case RequestKind::attach:
+      ack.motion = arm.last_queued();
+      return;
+    case RequestKind::halt:
+      arm.halt();
+      l.follows.clear();
+      l.streams.clear();
+      ack.motion = arm.last_queued();
+      return;
+    case RequestKind::hand:
+      arm.set_hand(r.value > 0.5);
+      ack.motion = arm.last_queued();
+      return;
+    case RequestKind::nextmove:
+      arm.generator().request_next();
+      ack.motion = arm.last_queued();
+      return;
+    case RequestKind::move:
+    case RequestKind::dwell:
+      break;
+    default:
+      throw CodecError(fmt::format("unknown request kind {}", int{r.kind}));
+  }
+  // The settings this motion is queued with.
+  const rccl::MotionSettings s = decode_settings(r);
+  arm.set_mode(s.mode);
+  arm.set_velocity(s.translation_m_per_s, s.rotation_rad_per_s);
+  arm.set_segment_time(s.segment_time_s);
+  arm.set_transition_time(s.transition_time_s);
+  const auto names = arm.kinematics().configuration_names();
+  if (s.configuration >= 0 && static_cast<std::size_t>(s.configuration) >= names.size()) {
+    throw CodecError(fmt::format("robot {} has no configuration {}", l.name, s.configuration));
+  }
+  arm.set_configuration(s.configuration < 0 ? std::string_view{} : names[s.configuration]);
+  if (s.guard.on() || arm.settings().guard.on()) arm.set_guard(s.guard);
+  if (s.compliance.any() || arm.settings().compliance.any()) arm.set_compliance(s.compliance);
+  // The gates: this process's robots from the cell, others' from their states.
+  rccl::StartWhen when;
+  when.touch = s.may_touch;
+  for (std::size_t i = 0; i < std::min<std::size_t>(r.gates, 4); ++i) {
+    const rccx_net_Gate& g = r.after[i];
+    const std::string robot(text_of(g.robot));
+    const auto gk = g.kind == 0 ? rccl::EventGate::Kind::started : rccl::EventGate::Kind::ended;
+    if (local(robot) != nullptr) {
+      rccl::Event e;
+      e.kind = g.kind == 0 ? rccl::Event::Kind::motion_start : rccl::Event::Kind::motion_end;
+      e.id = g.motion;
+      when.after.push_back(cell_->event(robot, e));
+    } else if (const auto it = mirrors_.find(robot); it != mirrors_.end()) {
+      when.after.push_back(rccl::EventGate{&it->second->ledger, gk, g.motion});
+    } else {
+      throw CodecError(
+          fmt::format("gate on robot {}: not a robot of cell {}", robot, full_model_.name));
+    }
+  }
+  std::set<std::string> follows, streams;
+  if (kind == RequestKind::dwell) {
+    ack.motion = arm.dwell(r.value, when).id;
+    return;
+  }
+  const Resolver resolve = [&](TermKind k, std::string_view name) -> rccl::TransformPtr {
+    const std::string n(name);
+    switch (k) {
+      case TermKind::frame:
+        if (local(n) != nullptr) return cell_->tool_frame(n);
+        if (const auto it = mirrors_.find(n); it != mirrors_.end()) {
+          if (!it->second->has_state() || it->second->lost()) {
+            throw CodecError(fmt::format(
+                "frame:{}: robot {}'s state is not received here: start its serve process "
+                "(rccx serve --robots {}) on domain {}",
+                n, n, n, participant_->domain()));
+          }
+          follows.insert(n);
+          return remote_frame(n + "_TOOL", "frame:" + n, &it->second->frame,
+                              options_.net.detection);
+        }
+        throw CodecError(fmt::format("frame:{}: not a robot of cell {}", n, full_model_.name));
+      case TermKind::function: {
+        const auto it = functions_.find(n);
+        if (it == functions_.end()) {
+          std::vector<std::string> known;
+          for (const auto& [k2, v] : functions_) known.push_back(k2);
+          throw CodecError(fmt::format(
+              "function:{} is not registered in this serve process ({}){}", n, participant_name_,
+              known.empty() ? std::string(": it has none")
+                            : fmt::format("; registered: {}", join(known))));
+        }
+        auto t = rccl::functional(n, it->second);
+        t->set_reference("function:" + n);
+        return t;
+      }
+      case TermKind::stream: {
+        const auto it = streams_.find(n);
+        if (it == streams_.end() || it->second->lost) {
+          throw CodecError(fmt::format(
+              "stream:{}: no sample received; the program writes it (RemoteCell::stream(\"{}\")"
+              ".set(...)) before a motion uses it",
+              n, n));
+        }
+        streams.insert(n);
+        return remote_frame(n, "stream:" + n, &it->second->frame, options_.net.detection);
+      }
+      default:
+        break;
+    }
+    throw CodecError(fmt::format("transform {}: not a functional kind", n));
+  };
+  const rccl::PositionPtr p = decode_position(r, resolve);
+  ack.motion = arm.move(p, when).id;
+  l.follows = std::move(follows);  // a Cartesian rest goes on tracking the last goal
+  l.streams = std::move(streams);
+}
+
+void RobotServer::halt_with(Local& l, const std::string& why) {
+  l.halt_reason = why;
+  l.halt_upto = l.arm->last_queued();
+  l.arm->halt();
+  l.follows.clear();
+  l.streams.clear();
+}
+
+void RobotServer::publish_events() {
+  for (auto& lp : locals_) {
+    Local& l = *lp;
+    for (const rccl::MotionEvent& e : l.arm->take_events()) {
+      rccx_net_MotionEvent out{};
+      copy_to(out.robot, l.name);
+      out.motion = e.id;
+      if (const auto it = l.origin.find(e.id); it != l.origin.end()) {
+        copy_to(out.program, it->second.program);
+        out.request = it->second.request;
+      }
+      out.kind = static_cast<std::uint8_t>(e.kind);
+      out.t_s = e.t_s;
+      const bool bad = e.kind == rccl::EventKind::failed || e.kind == rccl::EventKind::cancelled;
+      if (bad && !l.halt_reason.empty() && e.id <= l.halt_upto) {
+        copy_to(out.text, l.halt_reason);
+      } else {
+        copy_to(out.text, e.message());
+      }
+      check(dds_write(event_writer_.get(), &out), "a motion event");
+    }
+  }
+}
+
+void RobotServer::publish_states(std::int64_t now, bool last) {
+  for (auto& lp : locals_) {
+    Local& l = *lp;
+    const bool fresh = l.latest.take(l.slot);
+    l.have_slot = l.have_slot || fresh;
+    // A fresh sample, or the last one again every heartbeat period: a robot sampled more
+    // slowly than the detection time (the Microbo's 28 ms) still shows it is alive.
+    if (!fresh && !last && now - l.written_ns < options_.net.heartbeat.count()) continue;
+    if (!l.have_slot) continue;
+    rccx_net_RobotState s{};
+    copy_to(s.robot, l.name);
+    copy_to(s.participant, participant_name_);
+    s.instance = instance_;
+    s.sample = l.slot.sample;
+    s.t_s = l.slot.t_s;
+    s.stamp_ns = l.slot.stamp_ns;
+    s.written_ns = wall_ns();
+    s.period_s = l.period_s;
+    s.dof = l.slot.dof;
+    for (std::size_t j = 0; j < l.slot.dof; ++j) s.q_commanded[j] = l.slot.q[j];
+    const rtc::How h = l.session->how();
+    for (std::size_t j = 0; j < std::min<std::size_t>(h.dof, 8); ++j) {
+      s.q_measured[j] = h.q()[j];
+    }
+    to_pose(l.slot.tool.pose, s.tool);
+    const cell::ToolSample& t = l.slot.tool;
+    const math::Vec3 v[3] = {t.velocity_m_per_s, t.acceleration_m_per_s2, t.angular_velocity_rad_s};
+    double* out[3] = {s.velocity, s.acceleration, s.angular_velocity};
+    for (int k = 0; k < 3; ++k) {
+      out[k][0] = v[k].x;
+      out[k][1] = v[k].y;
+      out[k][2] = v[k].z;
+    }
+    // The counters before the failure ranges: a failure marked before `ended` advanced is
+    // seen with it (MotionLedger::mark_failed writes the range first).
+    const rccl::MotionLedger& ledger = l.gen->ledger();
+    s.started_upto = ledger.started_upto();
+    s.ended_upto = ledger.ended_upto();
+    s.control_ended = ledger.control_ended() || last;
+    (void)ledger.newest_failures(s.failed_from, s.failed_to, 4);
+    const rtc::TerminateCode code = l.session->ended_code();
+    if (code != rtc::TerminateCode::none) {
+      s.status = static_cast<std::uint8_t>(RobotStatus::ended);
+      s.terminate_code = static_cast<std::int16_t>(code);
+      const rtc::Termination term = l.session->termination();
+      copy_to(s.termination,
+              term.message_view().empty() ? term.detail_view() : term.message_view());
+      s.control_ended = true;
+    } else if (last) {
+      s.status = static_cast<std::uint8_t>(RobotStatus::ended);
+      copy_to(s.termination, "the serve process stopped");
+    } else {
+      s.status = static_cast<std::uint8_t>(l.slot.running != 0 ? RobotStatus::moving
+                                                               : RobotStatus::at_rest);
+    }
+    s.running = l.slot.running;
+    s.queued = l.arm->last_queued();
+    copy_to(s.program, l.program);
+    check(dds_write(state_writer_.get(), &s), "a robot state");
+    l.written_ns = now;
+  }
+}
+
+void RobotServer::check_lost(std::int64_t now) {
+  const std::int64_t detection = options_.net.detection.count();
+  // Programs: an attached program silent for the detection time is lost.
+  for (auto& lp : locals_) {
+    Local& l = *lp;
+    if (l.program.empty()) continue;
+    std::int64_t seen = l.attached_ns;
+    if (const auto it = programs_.find(l.program);
+        it != programs_.end() && it->second.instance == l.program_instance) {
+      seen = std::max(seen, it->second.seen_ns);
+    }
+    if (now - seen <= detection) continue;
+    const std::string why =
+        fmt::format("the program {} was lost (no heartbeat for {:.0f} ms): stopped smoothly",
+                    l.program, ms_of(now - seen));
+    io::eprint("rccx serve: robot {}: {}\n", l.name, why);
+    halt_with(l, why);
+    l.program.clear();
+    l.program_instance = 0;
+  }
+  // Remote robots: a state older than the detection time is lost; a local robot following
+  // its frame stops smoothly.
+  for (auto& [name, m] : mirrors_) {
+    if (!m->has_state() || m->lost()) continue;
+    const std::int64_t silent = now - m->received_ns();
+    if (silent <= detection) continue;
+    m->set_lost(true);
+    const std::string lost =
+        fmt::format("robot {} lost: its serve process {} is silent for {:.0f} ms", name,
+                    m->participant(), ms_of(silent));
+    io::eprint("rccx serve: {}\n", lost);
+    for (auto& lp : locals_) {
+      if (lp->follows.count(name) == 0) continue;
+      const std::string why =
+          fmt::format("robot {} follows the frame of {}: stopped smoothly", lp->name, lost);
+      io::eprint("rccx serve: {}\n", why);
+      halt_with(*lp, why);
+    }
+  }
+  for (auto& [name, s] : streams_) {
+    if (s->lost || now - s->received_ns <= detection) continue;
+    s->lost = true;
+    for (auto& lp : locals_) {
+      if (lp->streams.count(name) == 0) continue;
+      const std::string why =
+          fmt::format("robot {} follows stream {}, silent for {:.0f} ms: stopped smoothly",
+                      lp->name, name, ms_of(now - s->received_ns));
+      io::eprint("rccx serve: {}\n", why);
+      halt_with(*lp, why);
+    }
+  }
+}
+
+}  // namespace rccx::net

@@ -1,0 +1,145 @@
+// A serve process's heart (`rccx serve`, docs/NETWORK.md): some robots of a cell, their RTC
+// sessions, generators and collision check in this process on its real-time clock, commanded
+// over DDS by programs in other processes.
+//
+//   net::ServeOptions o;  o.net.domain = 7;  o.net.interface = "lo";
+//   net::RobotServer serve(cell::load_cell_file("cells/cvarl.json"), {"puma"}, o);
+//   serve.register_function("CONV", conveyor);        // "function:CONV" in a program's equation
+//   serve.start();                                    // claims, control, the middleware thread
+//   while (!stopped) ...;
+//   serve.stop();                                     // halts smoothly, gives the claims back
+//
+// Threads: the cell's control task (never calls DDS: after each tick its cycle observer copies
+// each robot's setpoint into a triple buffer) and one middleware thread that polls every 1 ms:
+// it writes states and heartbeats, takes requests (all Manipulator calls are made from it),
+// answers them, publishes the motions' events, and stops the robots of a lost program or of a
+// lost leader smoothly (Manipulator::halt) saying why.
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "rccx/cell/cell.hpp"
+#include "rccx/cell/cell_model.hpp"
+#include "rccx/net/dds.hpp"
+#include "rccx/net/mirror.hpp"
+#include "rccx/rccl/transforms.hpp"
+
+namespace rccx::net {
+
+/// Another serve process holds a robot asked for (or won the race for it); the message names it.
+class ClaimRefused : public NetError {
+ public:
+  using NetError::NetError;
+};
+
+struct ServeOptions {
+  NetOptions net;
+  /// How long to listen for other processes' claims before claiming (discovery time), and
+  /// again after claiming (a race).
+  std::chrono::nanoseconds claim_wait = std::chrono::milliseconds(300);
+  /// SCHED_FIFO and mlockall for the control task when allowed.
+  bool real_time_scheduling = true;
+};
+
+/// The part of `model` a serve process of `robots` runs: those robots only, its objects and
+/// frames. Throws std::invalid_argument naming the cell's robots for an unknown or repeated
+/// name, or for none. The one place a serve's cell is cut out (later: the others as remote
+/// robots in the collision check, CellOptions::local_robots).
+cell::CellModel served_model(const cell::CellModel& model, const std::vector<std::string>& robots);
+
+class RobotServer {
+ public:
+  /// Checks the robots (std::invalid_argument as served_model); nothing runs yet.
+  RobotServer(cell::CellModel model, std::vector<std::string> robots, ServeOptions options);
+  /// stop().
+  ~RobotServer();
+  RobotServer(const RobotServer&) = delete;
+  RobotServer& operator=(const RobotServer&) = delete;
+
+  /// A functional transform programs may name "function:<name>". Before start() only.
+  void register_function(std::string name, rccl::TransformFunction function);
+
+  /// Joins the domain, claims the robots (ClaimRefused when another live process holds one),
+  /// builds and starts the cell in real time, then the middleware thread. Throws NetError,
+  /// ClaimRefused, what the cell throws.
+  void start();
+  /// Halts every robot smoothly (up to 2 s to come to rest), says so in a last state, gives the
+  /// claims back and ends control. Idempotent.
+  void stop();
+
+  /// One line: what it serves, the domain, interface, plain or secure.
+  [[nodiscard]] std::string banner() const;
+  [[nodiscard]] const std::string& participant() const noexcept { return participant_name_; }
+  /// Set when the middleware thread stopped on an error (what went wrong); "" while all is well.
+  [[nodiscard]] std::string failure() const;
+  [[nodiscard]] cell::Cell& cell() noexcept { return *cell_; }
+
+ private:
+  struct Local;
+  struct Dedup;
+  struct Program {
+    std::uint64_t instance = 0;
+    std::int64_t seen_ns = 0;  ///< steady clock, last heartbeat
+  };
+  struct Stream {
+    cell::SeqLock<FrameState> frame;
+    std::int64_t received_ns = 0;
+    bool lost = false;
+  };
+
+  void claim();
+  void release_claims() noexcept;
+  void run() noexcept;
+  void poll();
+  void read_heartbeats(std::int64_t now);
+  void read_states(std::int64_t now);
+  void read_frames(std::int64_t now);
+  void read_requests(std::int64_t now);
+  void handle(const rccx_net_MotionRequest& r, std::int64_t now);
+  void execute(Local& l, const rccx_net_MotionRequest& r, rccx_net_MotionAck& ack);
+  void publish_events();
+  void publish_states(std::int64_t now, bool last = false);
+  void check_lost(std::int64_t now);
+  /// Halts `l` smoothly; the events of its motions up to the last queued say `why`.
+  void halt_with(Local& l, const std::string& why);
+  void on_cycle() noexcept;
+  [[nodiscard]] Local* local(std::string_view robot) noexcept;
+
+  cell::CellModel full_model_;
+  std::vector<std::string> robot_names_;
+  ServeOptions options_;
+  std::map<std::string, rccl::TransformFunction> functions_;
+
+  std::string participant_name_;
+  std::uint64_t instance_ = 0;
+  std::unique_ptr<Participant> participant_;
+  Entity hb_writer_, hb_reader_, claim_writer_, claim_reader_, state_writer_, state_reader_,
+      request_reader_, ack_writer_, event_writer_, frame_reader_;
+  std::vector<rccx_net_Claim> claims_;
+
+  std::unique_ptr<cell::Cell> cell_;
+  std::vector<std::unique_ptr<Local>> locals_;
+  std::map<std::string, std::unique_ptr<RobotMirror>> mirrors_;  ///< the cell's other robots
+  std::map<std::string, std::unique_ptr<Stream>> streams_;
+  std::map<std::string, Program> programs_;
+  std::map<std::string, std::unique_ptr<Dedup>> dedup_;  ///< by "<program>|<robot>"
+
+  std::thread thread_;
+  std::atomic<bool> stop_{false};
+  bool started_ = false;
+  bool stopped_ = false;
+  std::int64_t last_heartbeat_ns_ = 0;
+  std::uint64_t heartbeat_seq_ = 0;
+  mutable std::mutex failure_mutex_;
+  std::string failure_;
+};
+
+}  // namespace rccx::net

@@ -1,0 +1,543 @@
+// The cell across processes (issue 29): `rccx serve` processes spawned from the rccx
+// executable on loopback, each test on a DDS domain of its own, and RemoteCell programs (this
+// test, or a child to kill). Times are real; bounds are generous for a loaded 2-core machine,
+// and the measured figures are printed.
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <mutex>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "rccx/cell/cell.hpp"
+#include "rccx/cell/cell_model.hpp"
+#include "rccx/net/codec.hpp"
+#include "rccx/net/dds.hpp"
+#include "rccx/net/remote_cell.hpp"
+#include "rccx/rccl/trajectory.hpp"
+
+extern char** environ;
+
+using namespace rccx;
+using namespace std::chrono_literals;
+
+namespace {
+
+const std::string kCell = std::string(RCCX_CELLS_DIR) + "/cvarl.json";
+/// Detection in these tests: longer than the 20 ms default so that a loaded machine's stalls
+/// of a normal-priority thread do not count as lost links; the bounds below scale with it.
+constexpr int kDetectionMs = 50;
+
+/// A domain of this test process's own (ctest runs each test in a process of its own).
+std::uint32_t domain(int k = 0) {
+  return 140 + static_cast<std::uint32_t>(getpid() % 40) * 2 + static_cast<std::uint32_t>(k);
+}
+
+net::NetOptions loopback(std::uint32_t d) {
+  net::NetOptions o;
+  o.domain = d;
+  o.interface = "lo";
+  o.detection = std::chrono::milliseconds(kDetectionMs);
+  o.heartbeat = o.detection / 4;
+  return o;
+}
+
+std::int64_t now_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(
+             std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+
+std::string read_file(const std::string& path) {
+  std::ifstream f(path);
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+/// A child process, its stdout and stderr in files; killed at the end if still running.
+class Child {
+ public:
+  Child(const std::vector<std::string>& args, const std::string& tag) {
+    out_ = ::testing::TempDir() + "rccx_" + tag + "_" + std::to_string(getpid()) + ".out";
+    err_ = ::testing::TempDir() + "rccx_" + tag + "_" + std::to_string(getpid()) + ".err";
+    posix_spawn_file_actions_t fa;
+    posix_spawn_file_actions_init(&fa);
+    posix_spawn_file_actions_addopen(&fa, 1, out_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    posix_spawn_file_actions_addopen(&fa, 2, err_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    std::vector<char*> argv;
+    for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    if (posix_spawn(&pid_, argv[0], &fa, nullptr, argv.data(), environ) != 0) pid_ = -1;
+    posix_spawn_file_actions_destroy(&fa);
+  }
+  ~Child() {
+    if (pid_ <= 0 || exited_) return;
+    kill(pid_, SIGTERM);
+    if (wait_exit(5s) == -1) {
+      kill(pid_, SIGKILL);
+      (void)wait_exit(5s);
+    }
+  }
+  Child(const Child&) = delete;
+  Child& operator=(const Child&) = delete;
+
+  [[nodiscard]] pid_t pid() const { return pid_; }
+  void kill9() {
+    kill(pid_, SIGKILL);
+    (void)wait_exit(5s);
+  }
+  /// The exit code, 128 + signal, or -1 when still running after `timeout`.
+  int wait_exit(std::chrono::nanoseconds timeout) {
+    if (exited_) return code_;
+    const auto until = std::chrono::steady_clock::now() + timeout;
+    while (std::chrono::steady_clock::now() < until) {
+      int status = 0;
+      if (waitpid(pid_, &status, WNOHANG) == pid_) {
+        exited_ = true;
+        code_ = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+        return code_;
+      }
+      std::this_thread::sleep_for(5ms);
+    }
+    return -1;
+  }
+  [[nodiscard]] std::string out() const { return read_file(out_); }
+  [[nodiscard]] std::string err() const { return read_file(err_); }
+  /// Waits until stdout holds `text` (or the child ended, or timeout).
+  bool wait_out(const std::string& text, std::chrono::nanoseconds timeout) {
+    const auto until = std::chrono::steady_clock::now() + timeout;
+    while (std::chrono::steady_clock::now() < until) {
+      if (out().find(text) != std::string::npos) return true;
+      std::this_thread::sleep_for(10ms);
+    }
+    return false;
+  }
+
+ private:
+  pid_t pid_ = -1;
+  std::string out_, err_;
+  bool exited_ = false;
+  int code_ = -1;
+};
+
+std::unique_ptr<Child> serve(std::uint32_t d, const std::string& robots, const std::string& tag) {
+  return std::make_unique<Child>(
+      std::vector<std::string>{RCCX_EXE, "serve", "--cell", kCell, "--robots", robots, "--domain",
+                               std::to_string(d), "--interface", "lo", "--detection",
+                               std::to_string(kDetectionMs) + "ms", "--claim-wait", "200ms",
+                               "--seconds", "120"},
+      tag);
+}
+
+/// Every RobotState sample of the domain, one record per (robot, sample).
+class StateRecorder {
+ public:
+  struct Record {
+    std::uint64_t sample = 0;
+    double t_s = 0.0;
+    double period_s = 0.0;
+    kin::JointVector q;
+    math::Transform tool;
+    std::uint64_t running = 0;
+    std::int64_t received_ns = 0;
+  };
+  explicit StateRecorder(std::uint32_t d)
+      : participant_(loopback(d)),
+        reader_(
+            participant_.reader(net::Topic::state, std::chrono::milliseconds(kDetectionMs * 10))) {
+    thread_ = std::thread([this] {
+      rccx_net_RobotState s{};
+      void* ptrs[1] = {&s};
+      dds_sample_info_t info[1];
+      while (!stop_) {
+        while (dds_take(reader_.get(), ptrs, info, 1, 1) == 1) {
+          if (!info[0].valid_data) continue;
+          Record r;
+          r.sample = s.sample;
+          r.t_s = s.t_s;
+          r.period_s = s.period_s;
+          r.q = kin::JointVector(s.dof);
+          for (std::size_t j = 0; j < s.dof; ++j) r.q[j] = s.q_commanded[j];
+          r.tool = net::from_pose(s.tool);
+          r.running = s.running;
+          r.received_ns = now_ns();
+          std::lock_guard lock(mutex_);
+          auto& v = records_[std::string(net::text_of(s.robot))];
+          if (v.empty() || v.back().sample != r.sample) v.push_back(r);
+        }
+        std::this_thread::sleep_for(1ms);
+      }
+    });
+  }
+  ~StateRecorder() {
+    stop_ = true;
+    thread_.join();
+  }
+  std::vector<Record> of(const std::string& robot) {
+    std::lock_guard lock(mutex_);
+    return records_[robot];
+  }
+
+ private:
+  net::Participant participant_;
+  net::Entity reader_;
+  std::mutex mutex_;
+  std::map<std::string, std::vector<Record>> records_;
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
+};
+
+/// The generator's acceleration bounds for a robot of the cell (rad/s^2), as the serve has them.
+kin::JointVector acceleration_bounds(const std::string& robot) {
+  const cell::CellModel m = cell::load_cell_file(kCell);
+  const cell::CellRobot* r = m.find_robot(robot);
+  const auto k = kin::make_kinematics(r->model);
+  rccl::GeneratorOptions o;
+  o.period_s = std::chrono::duration<double>(m.period(0)).count();
+  const rccl::TrajectoryGenerator g(*k, o);
+  return g.options().max_acceleration;
+}
+
+/// The largest |second difference| / P^2 over bounds, per joint, over consecutive samples from
+/// index `from` on: 1 means at the bound.
+double worst_acceleration_ratio(const std::vector<StateRecorder::Record>& v, std::size_t from,
+                                const kin::JointVector& bound) {
+  double worst = 0.0;
+  for (std::size_t i = std::max<std::size_t>(from, 2); i < v.size(); ++i) {
+    if (v[i].sample != v[i - 1].sample + 1 || v[i - 1].sample != v[i - 2].sample + 1) continue;
+    const double P = v[i].period_s;
+    for (std::size_t j = 0; j < v[i].q.size(); ++j) {
+      const double a = (v[i].q[j] - 2 * v[i - 1].q[j] + v[i - 2].q[j]) / (P * P);
+      worst = std::max(worst, std::abs(a) / bound[j]);
+    }
+  }
+  return worst;
+}
+
+bool contains(const std::string& s, const std::string& part) {
+  return s.find(part) != std::string::npos;
+}
+
+math::Transform tool_down(double x, double y, double z) {
+  math::Transform t;
+  t.R = math::Rot3::rot_x(M_PI);
+  t.p = {x, y, z};
+  return t;
+}
+
+}  // namespace
+
+TEST(NetServe, ProgramMovesRobotsOfAServeAndARefusalThrowsTheServesReason) {
+  const std::uint32_t d = domain();
+  auto s = serve(d, "puma,microbo", "serve_basic");
+  net::RemoteCell cell(cell::load_cell_file(kCell), loopback(d));
+  net::RemoteArm& puma = cell.robot("puma");
+  net::RemoteArm& microbo = cell.robot("microbo");
+
+  // A joint move of the PUMA.
+  kin::JointVector q = puma.state().q_commanded;
+  q[0] += 0.2;
+  q[2] -= 0.1;
+  const rccl::Motion m1 = puma.move(rccl::Position::joints("J1", q));
+  EXPECT_GE(m1.id, 1U);
+  EXPECT_EQ(puma.last_queued(), m1.id);
+  // A Cartesian move of the Microbo: 20 mm up from where its tool is.
+  math::Transform up = microbo.state().tool.pose;
+  up.p.z += 0.02;
+  microbo.set_mode(rccl::Mode::cartesian);
+  microbo.set_velocity(0.05, 0.5);
+  const rccl::Motion m2 = microbo.move(cell.world_goal("microbo", "UP", up));
+  ASSERT_EQ(puma.waitfor(m1.end(), 15s), rccl::WaitResult::reached);
+  ASSERT_EQ(microbo.waitfor(m2.end(), 15s), rccl::WaitResult::reached);
+  std::this_thread::sleep_for(100ms);
+  const net::RemoteState ps = puma.state();
+  for (std::size_t j = 0; j < q.size(); ++j) EXPECT_NEAR(ps.q_commanded[j], q[j], 1e-6);
+  EXPECT_EQ(ps.ended_upto, m1.id);
+  EXPECT_EQ(ps.program, cell.participant());
+  EXPECT_LT(ps.age, 1s);
+  EXPECT_NEAR((microbo.state().tool.pose.p - up.p).norm(), 0.0, 0.5e-3);
+
+  // Events: started and ended, with the motion's id.
+  bool started = false, ended = false;
+  for (const auto& e : puma.take_events()) {
+    if (e.id != m1.id) continue;
+    started = started || e.kind == rccl::EventKind::started;
+    ended = ended || e.kind == rccl::EventKind::ended;
+  }
+  EXPECT_TRUE(started && ended);
+
+  // A goal out of reach: refused by the serve, thrown here with its reason; nothing queued.
+  try {
+    (void)puma.move(cell.world_goal("puma", "FAR", tool_down(3.0, 0, 0.5)));
+    FAIL() << "an unreachable goal was accepted";
+  } catch (const rccl::MotionError& e) {
+    EXPECT_TRUE(contains(e.what(), "FAR")) << e.what();
+    EXPECT_FALSE(contains(e.what(), "did not answer")) << e.what();
+    std::printf("refusal: %s\n", e.what());
+  }
+  EXPECT_EQ(puma.last_queued(), m1.id);
+  EXPECT_EQ(puma.state().queued, m1.id);
+  // An unnamed functional transform cannot cross; the message says how to name it.
+  auto f = rccl::functional("WOBBLE",
+                            [](const rccl::SampleContext&) { return math::Transform::identity(); });
+  EXPECT_THROW((void)puma.move(cell.world_goal("puma", "W", {f})), rccl::MotionError);
+}
+
+TEST(NetServe, ARepeatedRequestIdIsNotExecutedTwice) {
+  const std::uint32_t d = domain();
+  auto s = serve(d, "puma", "serve_dup");
+  net::RemoteOptions ro;
+  ro.robots = {"puma"};
+  net::RemoteCell cell(cell::load_cell_file(kCell), loopback(d), ro);  // waits for the serve
+  const std::uint64_t before = cell.robot("puma").state().queued;
+
+  // A program by hand: a raw writer sends request 1 twice.
+  const net::Participant p(loopback(d));
+  const net::Entity w = p.writer(net::Topic::request);
+  const net::Entity r = p.reader(net::Topic::ack);
+  const net::Entity hb = p.writer(net::Topic::heartbeat);
+  rccx_net_MotionRequest req{};
+  net::copy_to(req.robot, "puma");
+  net::copy_to(req.program, "program/test/dup");
+  req.program_instance = 99;
+  req.request = 1;
+  req.kind = static_cast<std::uint8_t>(net::RequestKind::dwell);
+  net::encode_settings(rccl::MotionSettings{}, req);
+  req.value = 0.05;
+  std::vector<rccx_net_MotionAck> acks;
+  const auto until = std::chrono::steady_clock::now() + 10s;
+  int sent = 0;
+  while (acks.size() < 2 && std::chrono::steady_clock::now() < until) {
+    dds_publication_matched_status_t st{};
+    dds_get_publication_matched_status(w.get(), &st);
+    if (st.current_count > 0 && sent < 2) {
+      ASSERT_GE(dds_write(w.get(), &req), 0);
+      ++sent;
+    }
+    rccx_net_MotionAck a{};
+    void* ptrs[1] = {&a};
+    dds_sample_info_t info[1];
+    while (dds_take(r.get(), ptrs, info, 1, 1) == 1) {
+      if (info[0].valid_data && net::text_of(a.program) == "program/test/dup") acks.push_back(a);
+    }
+    std::this_thread::sleep_for(5ms);
+  }
+  ASSERT_EQ(acks.size(), 2U);
+  EXPECT_EQ(acks[0].result, static_cast<std::uint8_t>(net::AckResult::accepted));
+  EXPECT_EQ(acks[1].result, static_cast<std::uint8_t>(net::AckResult::duplicate));
+  EXPECT_EQ(acks[0].motion, before + 1);
+  EXPECT_EQ(acks[1].motion, acks[0].motion);
+  std::this_thread::sleep_for(200ms);
+  EXPECT_EQ(cell.robot("puma").state().queued, before + 1) << "the dwell was queued twice";
+  (void)hb;
+}
+
+TEST(NetServe, ASecondServeOfARobotIsRefusedNamingTheHolder) {
+  const std::uint32_t d = domain();
+  auto first = serve(d, "puma", "serve_first");
+  net::RemoteOptions ro;
+  ro.robots = {"puma"};
+  { net::RemoteCell cell(cell::load_cell_file(kCell), loopback(d), ro); }  // it runs
+  auto second = serve(d, "microbo,puma", "serve_second");
+  const int code = second->wait_exit(20s);
+  EXPECT_EQ(code, 2) << second->err();
+  const std::string err = second->err();
+  EXPECT_TRUE(contains(err, "robot puma is served already by serve/")) << err;
+  EXPECT_TRUE(contains(err, "pid " + std::to_string(first->pid()))) << err;
+  EXPECT_EQ(first->wait_exit(10ms), -1) << "the first serve stopped";
+}
+
+TEST(NetServe, AKilledServeFailsTheProgramsWaitWithinTheDetectionTime) {
+  const std::uint32_t d = domain();
+  auto s = serve(d, "puma", "serve_killed");
+  net::RemoteOptions ro;
+  ro.robots = {"puma"};
+  net::RemoteCell cell(cell::load_cell_file(kCell), loopback(d), ro);
+  net::RemoteArm& puma = cell.robot("puma");
+  const std::string holder = puma.state().participant;
+  kin::JointVector q = puma.state().q_commanded;
+  q[0] += 1.0;
+  puma.set_velocity(0.05, 0.2);
+  const rccl::Motion m = puma.move(rccl::Position::joints("FAR", q));
+  ASSERT_EQ(puma.waitfor(m.start(), 10s), rccl::WaitResult::reached);
+  std::atomic<std::int64_t> returned{0};
+  rccl::WaitResult result = rccl::WaitResult::reached;
+  std::thread waiter([&] {
+    result = puma.waitfor(m.end(), 30s);
+    returned = now_ns();
+  });
+  std::this_thread::sleep_for(200ms);
+  const std::int64_t killed = now_ns();
+  s->kill9();
+  waiter.join();
+  const double ms = static_cast<double>(returned - killed) * 1e-6;
+  std::printf(
+      "kill -9 of the serve -> the program's waitfor failed after %.1f ms (detection %d ms)\n", ms,
+      kDetectionMs);
+  EXPECT_EQ(result, rccl::WaitResult::failed);
+  EXPECT_LT(ms, 3.0 * kDetectionMs) << "detection took too long";
+  const auto f = puma.failures();
+  ASSERT_FALSE(f.empty());
+  const std::string why(f.back().message());
+  EXPECT_TRUE(contains(why, "robot puma lost: its serve process " + holder + " is silent")) << why;
+  EXPECT_THROW((void)puma.move(puma.park()), rccl::MotionError);
+
+  // A restarted serve is announced and the robot can be used again.
+  auto again = serve(d, "puma", "serve_again");
+  const auto until = std::chrono::steady_clock::now() + 15s;
+  while (std::chrono::steady_clock::now() < until && puma.state().participant == holder) {
+    std::this_thread::sleep_for(20ms);
+  }
+  std::this_thread::sleep_for(300ms);  // its request reader matched
+  const rccl::Motion back = puma.move(puma.park());
+  EXPECT_EQ(puma.waitfor(back.end(), 20s), rccl::WaitResult::reached);
+}
+
+TEST(NetServe, AKilledProgramsRobotStopsSmoothlyAndTheServeSaysWhy) {
+  const std::uint32_t d = domain();
+  auto s = serve(d, "puma", "serve_lostprog");
+  StateRecorder states(d);
+  net::RemoteOptions ro;
+  ro.robots = {"puma"};
+  net::RemoteCell watcher(cell::load_cell_file(kCell), loopback(d), ro);  // reads only
+  Child program(
+      {RCCX_PROGRAM_CHILD, kCell, std::to_string(d), std::to_string(kDetectionMs), "puma"},
+      "program_child");
+  ASSERT_TRUE(program.wait_out("moving", 20s)) << program.err();
+  std::this_thread::sleep_for(400ms);  // well into the motion, at speed
+  const std::int64_t killed = now_ns();
+  program.kill9();
+  // The robot comes to rest: commanded joints stop changing.
+  std::this_thread::sleep_for(3s);
+  const auto v = states.of("puma");
+  ASSERT_GT(v.size(), 50U);
+  std::size_t kill_index = 0;
+  while (kill_index < v.size() && v[kill_index].received_ns < killed) ++kill_index;
+  ASSERT_LT(kill_index + 5, v.size());
+  // Where it began to slow: the first sample after the kill whose speed drops (any joint).
+  std::size_t rest = v.size() - 1;
+  for (std::size_t i = kill_index; i + 1 < v.size(); ++i) {
+    double change = 0.0;
+    for (std::size_t j = 0; j < v[i].q.size(); ++j) change += std::abs(v[i + 1].q[j] - v[i].q[j]);
+    if (change < 1e-9) {
+      rest = i;
+      break;
+    }
+  }
+  ASSERT_LT(rest, v.size() - 1) << "the robot did not come to rest";
+  const double moving_ms = static_cast<double>(v[rest].received_ns - killed) * 1e-6;
+  const double ratio =
+      worst_acceleration_ratio(v, kill_index > 3 ? kill_index - 3 : 0, acceleration_bounds("puma"));
+  std::printf("kill -9 of the program -> at rest %.1f ms later; worst |accel| / bound = %.3f\n",
+              moving_ms, ratio);
+  EXPECT_LE(ratio, 1.0 + rccl::kAccelerationTolerance);
+  // The serve said why, and so did the motion's event.
+  const std::string err = s->err();
+  EXPECT_TRUE(contains(err, "was lost (no heartbeat for")) << err;
+  EXPECT_TRUE(contains(err, "stopped smoothly")) << err;
+  bool said = false;
+  for (const auto& e : watcher.robot("puma").take_events()) {
+    if (contains(std::string(e.message()), "was lost (no heartbeat")) said = true;
+  }
+  EXPECT_TRUE(said) << "no failed/cancelled event naming the lost program";
+  // The stop began within detection + a period (plus slack for a loaded machine): the speed at
+  // kill + detection + 3 periods is already below the speed at the kill.
+  const double P = v[kill_index].period_s;
+  const std::int64_t check_at =
+      killed + static_cast<std::int64_t>((kDetectionMs * 1e-3 + 3 * P) * 3e9);
+  std::size_t k = kill_index;
+  while (k + 1 < v.size() && v[k].received_ns < check_at) ++k;
+  const auto speed = [&](std::size_t i) {
+    return i == 0 ? 0.0 : std::abs(v[i].q[0] - v[i - 1].q[0]) / P;
+  };
+  EXPECT_LT(speed(k), speed(kill_index) + 1e-9) << "not slowing down yet";
+}
+
+TEST(NetServe, ARobotFollowsAnotherProcesssRobotAndStopsWhenThatServeDies) {
+  const std::uint32_t d = domain();
+  auto sp = serve(d, "puma", "serve_leader");
+  auto sm = serve(d, "microbo", "serve_follower");
+  StateRecorder states(d);
+  net::RemoteCell cell(cell::load_cell_file(kCell), loopback(d));
+  net::RemoteArm& puma = cell.robot("puma");
+  net::RemoteArm& microbo = cell.robot("microbo");
+  // The PUMA's tool over the board, pointing down; the Microbo's 60 mm to +x of it.
+  puma.set_mode(rccl::Mode::joint);
+  const rccl::Motion p1 = puma.move(cell.world_goal("puma", "OVER", tool_down(-0.03, 0.0, 0.19)));
+  ASSERT_EQ(puma.waitfor(p1.end(), 20s), rccl::WaitResult::reached) << [&] {
+    std::string s;
+    for (const auto& e : puma.failures()) s += std::string(e.message()) + "; ";
+    return s + "\nleader's serve: " + sp->err() + "\nfollower's serve: " + sm->err();
+  }();
+  const auto offset = rccl::constant("BESIDE", math::Transform::translation(0.06, 0, 0));
+  microbo.set_mode(rccl::Mode::joint);
+  const rccl::Motion f1 =
+      microbo.move(cell.world_goal("microbo", "FOLLOW", {cell.tool_frame("puma"), offset}));
+  ASSERT_EQ(microbo.waitfor(f1.end(), 20s), rccl::WaitResult::reached) << [&] {
+    std::string s;
+    for (const auto& e : microbo.failures()) s += std::string(e.message()) + "; ";
+    return s;
+  }();
+  // In Cartesian mode the Microbo goes on tracking its goal at rest (a joint motion's rest
+  // does not): the same goal again, the way a program follows a moving frame.
+  microbo.set_mode(rccl::Mode::cartesian);
+  const rccl::Motion f2 =
+      microbo.move(cell.world_goal("microbo", "FOLLOW", {cell.tool_frame("puma"), offset}));
+  ASSERT_EQ(microbo.waitfor(f2.end(), 20s), rccl::WaitResult::reached);
+  // The PUMA moves 30 mm along y, slowly; the Microbo's tool tracks it.
+  puma.set_mode(rccl::Mode::cartesian);
+  puma.set_velocity(0.02, 0.3);
+  const rccl::Motion p2 = puma.move(cell.world_goal("puma", "ASIDE", tool_down(-0.03, 0.03, 0.19)));
+  double worst_mm = 0.0;
+  rccl::WaitResult moved = rccl::WaitResult::timeout;
+  const auto until = std::chrono::steady_clock::now() + 20s;
+  while (std::chrono::steady_clock::now() < until &&
+         (moved = puma.waitfor(p2.end(), 20ms)) == rccl::WaitResult::timeout) {
+    const net::RemoteState a = puma.state(), b = microbo.state();
+    const math::Vec3 want = a.tool.pose.p + math::Vec3{0.06, 0, 0};
+    worst_mm = std::max(worst_mm, (b.tool.pose.p - want).norm() * 1e3);
+  }
+  ASSERT_EQ(moved, rccl::WaitResult::reached) << [&] {
+    std::string s;
+    for (const auto& e : puma.failures()) s += std::string(e.message()) + "; ";
+    for (const auto& e : microbo.failures()) s += std::string(e.message()) + "; ";
+    return s + "\nleader's serve: " + sp->err() + "\nfollower's serve: " + sm->err();
+  }();
+  std::printf("the Microbo tracked the PUMA's tool (other process) within %.2f mm\n", worst_mm);
+  EXPECT_LT(worst_mm, 5.0);
+  // Now the PUMA moves back and its serve dies mid-motion: the Microbo stops smoothly.
+  (void)puma.move(cell.world_goal("puma", "BACK", tool_down(-0.03, -0.03, 0.19)));
+  std::this_thread::sleep_for(600ms);
+  const std::int64_t killed = now_ns();
+  sp->kill9();
+  std::this_thread::sleep_for(2s);
+  const std::string err = sm->err();
+  EXPECT_TRUE(contains(err, "follows the frame of robot puma lost")) << err;
+  const auto v = states.of("microbo");
+  std::size_t kill_index = 0;
+  while (kill_index < v.size() && v[kill_index].received_ns < killed) ++kill_index;
+  const double ratio = worst_acceleration_ratio(v, kill_index > 3 ? kill_index - 3 : 0,
+                                                acceleration_bounds("microbo"));
+  std::printf("after the leader's serve died: worst |accel| / bound of the Microbo = %.3f\n",
+              ratio);
+  EXPECT_LE(ratio, 1.0 + rccl::kAccelerationTolerance);
+  ASSERT_GE(v.size(), 3U);
+  double last_change = 0.0;
+  for (std::size_t j = 0; j < v.back().q.size(); ++j) {
+    last_change += std::abs(v.back().q[j] - v[v.size() - 2].q[j]);
+  }
+  EXPECT_LT(last_change, 1e-9) << "the Microbo still moves";
+}
