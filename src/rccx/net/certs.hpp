@@ -13,6 +13,7 @@
 #pragma once
 
 #include <chrono>
+#include <cstdint>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -22,6 +23,9 @@
 #include "rccx/net/topics.hpp"
 
 namespace rccx::net {
+
+/// The highest DDS domain a secure participant may use (Cyclone's access control reads 0 .. 230).
+inline constexpr std::uint32_t kMaxSecureDomain = 230;
 
 /// What a participant may publish and subscribe (topic names, "rt/*" patterns allowed).
 struct Grants {
