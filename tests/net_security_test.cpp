@@ -214,7 +214,8 @@ TEST(NetSecurity, APermissionsFileWithoutStateCannotReadIt) {
   // Its permissions name no rule for rccx_state, and the default is DENY: even the topic is
   // refused, so rccx's participant (which makes every topic) is not made.
   EXPECT_EQ(peers[1].exit_code, 3) << peers[1].out;
-  EXPECT_TRUE(peers[1].says("participant_error: DDS topic rccx_state")) << peers[1].out;
+  EXPECT_TRUE(peers[1].says("participant_error: DDS topic rccx_state: Not Allowed By Security"))
+      << peers[1].out;
   expect_rejected(peers[1], "nostate", ex);
 }
 
@@ -225,7 +226,8 @@ TEST(NetSecurity, AServeProcessCannotSendMotionRequests) {
   expect_valid_program_got_through(peers[0], ex);
   // A serve process reads requests but may not publish them: its writer is refused.
   EXPECT_TRUE(peers[1].says("participant: ok")) << peers[1].out;
-  EXPECT_TRUE(peers[1].says("writer_error: a writer of rccx_request")) << peers[1].out;
+  EXPECT_TRUE(peers[1].says("writer_error: a writer of rccx_request: Not Allowed By Security"))
+      << peers[1].out;
   EXPECT_EQ(peers[1].value("requests_written"), 0) << peers[1].out;
   EXPECT_EQ(ex.requests_from.count("microbo"), 0U);
   // Serves read each other's state (frames, collision checks): that it may.

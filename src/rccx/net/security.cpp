@@ -91,9 +91,9 @@ void add_security_properties(dds_qos_t* qos, const NetOptions& options) {
   // Cyclone's access control reads domain ids 0 .. 230 only (its governance and permissions
   // parser); the documents of rccx certs cover exactly those.
   if (const std::uint32_t domain = domain_of(options); domain > kMaxSecureDomain) {
-    throw NetError(fmt::format(
-        "--secure: DDS domain {} is out of range for DDS Security: give 0 .. {}", domain,
-        kMaxSecureDomain));
+    throw NetError(
+        fmt::format("--secure: DDS domain {} is out of range for DDS Security: give 0 .. {}",
+                    domain, kMaxSecureDomain));
   }
   const fs::path& dir = options.secure_dir;
   const fs::path own = dir / options.secure_identity;
