@@ -10,6 +10,7 @@
 #include <map>
 
 #include "cell_command.hpp"
+#include "certs_command.hpp"
 #include "cli_common.hpp"
 #include "db_command.hpp"
 #include "kin_command.hpp"
@@ -369,6 +370,7 @@ std::unique_ptr<CLI::App> make_app(int& exit_code) {
   add_view_command(*app, exit_code);
   add_plot_command(*app, exit_code);
   add_serve_command(*app, exit_code);  // issue 29: robots served over DDS
+  add_certs_command(*app, exit_code);
   add_completion_command(*app, exit_code);
   verbs_take_parent_options(app.get(), true);
   return app;
