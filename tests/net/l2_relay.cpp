@@ -208,7 +208,8 @@ class Relay {
   void send_due(std::int64_t now_ns);
   void learn(const unsigned char* mac, int port);
   [[nodiscard]] int port_of(const unsigned char* mac) const;
-  void write_counters() const;
+  /// The counters to --json, and with `say` to stderr too (at the end; not when asked).
+  void write_counters(bool say = true) const;
 
   Options o_;
   std::int64_t delay_ns_;
@@ -384,7 +385,7 @@ int Relay::run(int signal_fd) {
         if (si.ssi_signo == SIGUSR1) {
           cut_ = !cut_;
         } else if (si.ssi_signo == SIGUSR2) {
-          write_counters();
+          write_counters(false);
         } else {
           write_counters();
           return 0;
@@ -397,7 +398,7 @@ int Relay::run(int signal_fd) {
   }
 }
 
-void Relay::write_counters() const {
+void Relay::write_counters(bool say) const {
   auto percentile_us = [&](double q) -> std::int64_t {
     if (delays_ == 0) return 0;
     const auto rank = static_cast<std::uint64_t>(std::ceil(q * static_cast<double>(delays_)));
@@ -429,13 +430,16 @@ void Relay::write_counters() const {
   const std::int64_t p50 = percentile_us(0.50), p99 = percentile_us(0.99);
   const double max_ms = static_cast<double>(max_delay_ns_) / 1e6;
   const double min_ms = delays_ == 0 ? 0.0 : static_cast<double>(min_delay_ns_) / 1e6;
-  std::fprintf(stderr,
-               "rccx_l2_relay: forwarded %llu, lost %llu, cut %llu, overflow %llu, max queue %zu; "
-               "delay (set %.3f ms) min %.3f p50 %.3f p99 %.3f max %.3f ms%s\n",
-               static_cast<unsigned long long>(forwarded), static_cast<unsigned long long>(lost),
-               static_cast<unsigned long long>(cut), static_cast<unsigned long long>(overflow),
-               max_count_, o_.delay_ms, min_ms, static_cast<double>(p50) / 1e3,
-               static_cast<double>(p99) / 1e3, max_ms, cut_ ? " (cut)" : "");
+  if (say) {
+    std::fprintf(
+        stderr,
+        "rccx_l2_relay: forwarded %llu, lost %llu, cut %llu, overflow %llu, max queue %zu; "
+        "delay (set %.3f ms) min %.3f p50 %.3f p99 %.3f max %.3f ms%s\n",
+        static_cast<unsigned long long>(forwarded), static_cast<unsigned long long>(lost),
+        static_cast<unsigned long long>(cut), static_cast<unsigned long long>(overflow), max_count_,
+        o_.delay_ms, min_ms, static_cast<double>(p50) / 1e3, static_cast<double>(p99) / 1e3, max_ms,
+        cut_ ? " (cut)" : "");
+  }
   if (o_.json_path.empty()) return;
   const std::string tmp = o_.json_path + ".tmp";
   FILE* f = std::fopen(tmp.c_str(), "w");
