@@ -97,8 +97,9 @@ double parse_number(const std::string& option, const char* text, double lo, doub
   errno = 0;
   const double v = std::strtod(text, &end);
   if (errno != 0 || end == text || *end != '\0' || !std::isfinite(v) || v < lo || v > hi) {
-    usage_error(option + " wants a number in " + std::to_string(lo) + " .. " + std::to_string(hi) +
-                ", not '" + text + "'");
+    char range[96];
+    std::snprintf(range, sizeof range, " wants a number in %g .. %g, not '", lo, hi);
+    usage_error(option + range + text + "'");
   }
   return v;
 }

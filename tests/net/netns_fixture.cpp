@@ -11,6 +11,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <cerrno>
 #include <cstdio>
 #include <cstdlib>
@@ -97,11 +98,16 @@ void sysctl_in(int netns_fd, const std::string& path, const std::string& value) 
 // ---- Child ----------------------------------------------------------------------------------
 
 Child::~Child() {
+  reap();
+}
+
+void Child::reap() noexcept {
   if (pid_ > 0 && !exit_) {
     kill(pid_, SIGKILL);
     int status = 0;
     waitpid(pid_, &status, 0);
   }
+  pid_ = -1;
 }
 
 Child::Child(Child&& o) noexcept : pid_(o.pid_), output_(std::move(o.output_)), exit_(o.exit_) {
@@ -110,7 +116,7 @@ Child::Child(Child&& o) noexcept : pid_(o.pid_), output_(std::move(o.output_)), 
 
 Child& Child::operator=(Child&& o) noexcept {
   if (this != &o) {
-    this->~Child();
+    reap();
     pid_ = o.pid_;
     output_ = std::move(o.output_);
     exit_ = o.exit_;
@@ -324,7 +330,7 @@ void Hosts::start_relay() {
 Child Hosts::spawn(int host, const std::vector<std::string>& argv,
                    const std::vector<std::string>& env) {
   const std::string& ns = host < 0 ? wire_ : names_.at(static_cast<std::size_t>(host));
-  static int serial = 0;
+  static std::atomic<int> serial{0};
   const std::string output = dir_ + "/child-" + std::to_string(++serial) + ".out";
   std::vector<std::string> full = {"ip", "netns", "exec", ns};
   if (!env.empty()) {

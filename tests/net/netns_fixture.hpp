@@ -25,6 +25,7 @@
 #include <optional>
 #include <string>
 #include <thread>
+#include <type_traits>
 #include <vector>
 
 namespace rccx::netns {
@@ -72,6 +73,8 @@ class Child {
   bool wait_for_output(const std::string& text, std::chrono::milliseconds limit) const;
 
  private:
+  void reap() noexcept;  ///< SIGKILL and wait, unless it ended and was waited for
+
   pid_t pid_ = -1;
   std::string output_;
   std::optional<int> exit_;
@@ -108,7 +111,8 @@ class Hosts {
   auto in(int host, F fn) -> decltype(fn());
 
   /// Starts `argv` in host `host`'s namespace (ip netns exec), with `env` ("NAME=value") added,
-  /// its output to a file; host -1: the wire namespace.
+  /// its output to a file; host -1: the wire namespace. Call it from a thread that outlives the
+  /// child (the test's own): the child is killed when the thread that started it ends.
   Child spawn(int host, const std::vector<std::string>& argv,
               const std::vector<std::string>& env = {});
 
