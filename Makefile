@@ -78,6 +78,15 @@ bench-cell: build-release
 	$(RELEASE_DIR)/bench/rccx_bench --benchmark_filter=BM_CellCycle \
 	  --benchmark_out=bench-results/cell.json --benchmark_out_format=json
 
+# The network layer on loopback (docs/NETWORK.md "Benchmark"): Cyclone's ddsperf ping/pong and
+# rccx's request round trip, state latency and robots at 1 kHz (bench/net_bench.cpp), one JSON
+# document (also bench-results/net.json); about a minute. Builds only the benchmark's target.
+.PHONY: bench-net
+bench-net: deps $(RELEASE_DIR)/CMakeCache.txt
+	$(CMAKE) --build $(RELEASE_DIR) -j$(JOBS) --target rccx_net_bench
+	@mkdir -p bench-results
+	scripts/bench-net --build $(RELEASE_DIR) --out bench-results/net.json
+
 format:
 	git ls-files '*.cpp' '*.hpp' | xargs clang-format -i
 

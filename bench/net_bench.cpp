@@ -1,0 +1,546 @@
+// rccx's network layer across processes on loopback, with its own types and net::Participant
+// (make bench-net; scripts/bench-net puts these beside Cyclone's ddsperf ping/pong):
+//
+//   BM_NetRequestAckRoundtrip   a MotionRequest written, its MotionAck taken: p50/p99/max over
+//                               100,000 round trips. The responder is a STAND-IN for the serve
+//                               process (a child of this program that acknowledges each request
+//                               at once); the real `rccx serve` replaces it later.
+//   BM_NetStateOneWay           RobotState from another process at 10 kHz: write (source
+//                               timestamp, CLOCK_REALTIME) to take, p50/p99/max over those of
+//                               110,000 written that the reader saw (keep last 1: it may miss
+//                               some).
+//   BM_NetStateFleet/N          N robots' RobotState written every 1 ms by another process for
+//                               a few seconds; the reader counts each robot's missing samples.
+//                               RobotState is best effort, keep last 1 by design: "lost" is a
+//                               sample the reader never saw (dropped, or overwritten before taken).
+//   BM_NetStateFleetBatched/N   the same with Cyclone's WriteBatch and one dds_write_flush a
+//                               period: what a serve process writing all its robots each sample
+//                               can do (net::Participant does not batch yet).
+//
+// Each case runs once (its own timing inside); the figures are user counters (us). The children
+// are this program again (--net-role ...), so each side is a process of its own.
+// Environment: RCCX_BENCH_DOMAIN (else 150 + pid % 50), RCCX_BENCH_FLEET_SECONDS (3),
+// RCCX_BENCH_ROUNDTRIPS (100000), RCCX_BENCH_SECURE_DIR (DDS Security's files of rccx certs init,
+// identities "program" here and "puma" in the child; untried until secure mode is done).
+// Diagnoses: RCCX_BENCH_LISTENER=1 (the responder answers from a listener, in Cyclone's receive
+// thread), RCCX_BENCH_KEEP_LAST=1 (request and ack reliable keep last 1, as ddsperf's ping/pong).
+#include <benchmark/benchmark.h>
+#include <fcntl.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <thread>
+#include <vector>
+
+#include "rccx/net/dds.hpp"
+
+extern char** environ;
+
+using namespace rccx;
+using namespace std::chrono_literals;
+
+namespace {
+
+long env_long(const char* name, long fallback) {
+  const char* v = std::getenv(name);
+  return (v != nullptr && *v != '\0') ? std::strtol(v, nullptr, 10) : fallback;
+}
+
+std::uint32_t bench_domain() {
+  return static_cast<std::uint32_t>(env_long("RCCX_BENCH_DOMAIN", 150 + getpid() % 50));
+}
+
+net::NetOptions options(std::uint32_t domain, const char* identity) {
+  net::NetOptions o;
+  o.domain = domain;
+  o.interface = "lo";
+  if (const char* dir = std::getenv("RCCX_BENCH_SECURE_DIR"); dir != nullptr && *dir != '\0') {
+    o.secure_dir = dir;
+    o.secure_identity = identity;
+  }
+  return o;
+}
+
+/// This program run again as `--net-role ARGS...`, its stdout read back through a pipe.
+class Child {
+ public:
+  explicit Child(const std::vector<std::string>& args) {
+    int fds[2];
+    if (pipe(fds) != 0) throw std::runtime_error("pipe failed");
+    std::vector<std::string> all{"/proc/self/exe", "--net-role"};
+    all.insert(all.end(), args.begin(), args.end());
+    std::vector<char*> argv;
+    for (std::string& a : all) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    posix_spawn_file_actions_t fa;
+    posix_spawn_file_actions_init(&fa);
+    posix_spawn_file_actions_adddup2(&fa, fds[1], STDOUT_FILENO);
+    posix_spawn_file_actions_addclose(&fa, fds[0]);
+    const int rc = posix_spawn(&pid_, "/proc/self/exe", &fa, nullptr, argv.data(), environ);
+    posix_spawn_file_actions_destroy(&fa);
+    close(fds[1]);
+    out_ = fds[0];
+    if (rc != 0) throw std::runtime_error("posix_spawn of the bench's child failed");
+  }
+  Child(const Child&) = delete;
+  Child& operator=(const Child&) = delete;
+  ~Child() { finish(0ms); }
+
+  /// Waits up to `grace` for the child to end, then kills it; returns what it printed.
+  std::string finish(std::chrono::milliseconds grace) {
+    if (pid_ > 0) {
+      const auto until = std::chrono::steady_clock::now() + grace;
+      int status = 0;
+      while (waitpid(pid_, &status, WNOHANG) == 0) {
+        if (std::chrono::steady_clock::now() >= until) {
+          kill(pid_, SIGKILL);
+          waitpid(pid_, &status, 0);
+          break;
+        }
+        std::this_thread::sleep_for(5ms);
+      }
+      pid_ = 0;
+    }
+    std::string text;
+    if (out_ >= 0) {
+      char buf[512];
+      ssize_t n = 0;
+      while ((n = read(out_, buf, sizeof buf)) > 0) text.append(buf, static_cast<std::size_t>(n));
+      close(out_);
+      out_ = -1;
+    }
+    return text;
+  }
+
+ private:
+  pid_t pid_ = 0;
+  int out_ = -1;
+};
+
+/// A waitset with one read condition on `reader`: wait() until it has data or `timeout`.
+class DataWait {
+ public:
+  DataWait(const net::Participant& p, dds_entity_t reader)
+      : ws_(net::check(dds_create_waitset(p.get()), "waitset")),
+        cond_(net::check(dds_create_readcondition(reader, DDS_ANY_STATE), "read condition")) {
+    net::check(dds_waitset_attach(ws_.get(), cond_.get(), 0), "waitset attach");
+  }
+  bool wait(dds_duration_t timeout) const {
+    return dds_waitset_wait(ws_.get(), nullptr, 0, timeout) > 0;
+  }
+
+ private:
+  net::Entity ws_;
+  net::Entity cond_;
+};
+
+bool wait_for(auto&& ready, std::chrono::seconds timeout) {
+  const auto until = std::chrono::steady_clock::now() + timeout;
+  while (!ready()) {
+    if (std::chrono::steady_clock::now() >= until) return false;
+    std::this_thread::sleep_for(2ms);
+  }
+  return true;
+}
+
+std::uint32_t writer_matches(dds_entity_t w) {
+  dds_publication_matched_status_t st{};
+  return dds_get_publication_matched_status(w, &st) >= 0 ? st.current_count : 0;
+}
+std::uint32_t reader_matches(dds_entity_t r) {
+  dds_subscription_matched_status_t st{};
+  return dds_get_subscription_matched_status(r, &st) >= 0 ? st.current_count : 0;
+}
+
+/// p50, p99, max of `ns` in us, set as the case's counters.
+void set_latency_counters(benchmark::State& state, std::vector<std::int64_t>& ns) {
+  if (ns.empty()) return;
+  std::sort(ns.begin(), ns.end());
+  const auto at = [&](double q) {
+    const auto i = static_cast<std::size_t>(q * static_cast<double>(ns.size() - 1));
+    return static_cast<double>(ns[i]) / 1e3;
+  };
+  state.counters["p50_us"] = at(0.50);
+  state.counters["p90_us"] = at(0.90);
+  state.counters["p99_us"] = at(0.99);
+  state.counters["max_us"] = static_cast<double>(ns.back()) / 1e3;
+  state.counters["samples"] = static_cast<double>(ns.size());
+}
+
+/// A reader / writer of `t` with the topic's QoS, or, with RCCX_BENCH_KEEP_LAST=1 (a diagnosis:
+/// what keep-all costs), reliable keep last 1 as ddsperf's ping/pong.
+net::Entity endpoint(const net::Participant& p, net::Topic t, bool writer) {
+  if (env_long("RCCX_BENCH_KEEP_LAST", 0) == 0) return writer ? p.writer(t) : p.reader(t);
+  const net::Qos qos;
+  dds_qset_reliability(qos.get(), DDS_RELIABILITY_RELIABLE, DDS_MSECS(100));
+  dds_qset_history(qos.get(), DDS_HISTORY_KEEP_LAST, 1);
+  const dds_entity_t e = writer ? dds_create_writer(p.get(), p.topic(t), qos.get(), nullptr)
+                                : dds_create_reader(p.get(), p.topic(t), qos.get(), nullptr);
+  return net::Entity(net::check(e, "bench endpoint"));
+}
+
+// ---- the children ----------------------------------------------------------------------------
+
+/// Takes the requests there are and acknowledges each at once (accepted, motion = request id).
+struct Acknowledger {
+  dds_entity_t requests;
+  dds_entity_t acks;
+  rccx_net_MotionAck ack{};
+  void operator()() {
+    void* buf[16] = {};
+    dds_sample_info_t info[16];
+    const dds_return_t n = dds_take(requests, buf, info, 16, 16);
+    for (dds_return_t i = 0; i < n; ++i) {
+      if (!info[i].valid_data) continue;
+      const auto* req = static_cast<const rccx_net_MotionRequest*>(buf[i]);
+      std::memcpy(ack.robot, req->robot, sizeof ack.robot);
+      std::memcpy(ack.program, req->program, sizeof ack.program);
+      ack.request = req->request;
+      ack.result = static_cast<std::uint8_t>(net::AckResult::accepted);
+      ack.motion = req->request;
+      dds_write(acks, &ack);
+    }
+    if (n > 0) dds_return_loan(requests, buf, n);
+  }
+};
+
+/// Stand-in for the serve process: acknowledges each MotionRequest at once, until the program's
+/// request writer has gone. From an application thread woken by a waitset (as a serve's
+/// middleware thread would), or with RCCX_BENCH_LISTENER=1 from Cyclone's receive thread (a
+/// data-available listener: one thread hand-over less a message).
+int run_responder(std::uint32_t domain) {
+  const net::Participant p(options(domain, "puma"));
+  const net::Entity requests = endpoint(p, net::Topic::request, false);
+  const net::Entity acks = endpoint(p, net::Topic::ack, true);
+  Acknowledger acknowledge{requests.get(), acks.get()};
+  const bool by_listener = env_long("RCCX_BENCH_LISTENER", 0) != 0;
+  if (by_listener) {
+    dds_listener_t* l = dds_create_listener(&acknowledge);
+    dds_lset_data_available(l,
+                            [](dds_entity_t, void* arg) { (*static_cast<Acknowledger*>(arg))(); });
+    net::check(dds_set_listener(requests.get(), l), "listener");
+    dds_delete_listener(l);
+  }
+  const DataWait wait(p, requests.get());
+  bool seen = false;
+  const auto give_up = std::chrono::steady_clock::now() + 150s;
+  while (std::chrono::steady_clock::now() < give_up) {
+    if (by_listener || !wait.wait(DDS_MSECS(200))) {
+      if (by_listener) std::this_thread::sleep_for(200ms);
+      const bool matched = reader_matches(requests.get()) > 0;
+      if (seen && !matched) break;  // the program is done
+      seen = seen || matched;
+      continue;
+    }
+    seen = true;
+    acknowledge();
+  }
+  if (by_listener) dds_set_listener(requests.get(), nullptr);
+  return 0;
+}
+
+/// Sleeps until `t` (CLOCK_MONOTONIC), then moves it on by `period_ns`.
+void pace(timespec& t, long period_ns) {
+  clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &t, nullptr);
+  t.tv_nsec += period_ns;
+  while (t.tv_nsec >= 1'000'000'000) {
+    t.tv_nsec -= 1'000'000'000;
+    ++t.tv_sec;
+  }
+}
+
+/// One robot's RobotState, `count` times at `rate_hz`, once a reader has matched.
+int run_state_writer(std::uint32_t domain, long count, long rate_hz) {
+  const net::Participant p(options(domain, "puma"));
+  const net::Entity w = p.writer(net::Topic::state);
+  if (!wait_for([&] { return writer_matches(w.get()) > 0; }, 30s)) return 2;
+  std::this_thread::sleep_for(300ms);  // the reader's side of discovery settles too
+  rccx_net_RobotState s{};
+  net::copy_to(s.robot, "puma");
+  s.dof = 6;
+  timespec t{};
+  clock_gettime(CLOCK_MONOTONIC, &t);
+  for (long i = 1; i <= count; ++i) {
+    pace(t, 1'000'000'000 / rate_hz);
+    s.sample = static_cast<std::uint64_t>(i);
+    dds_write(w.get(), &s);  // source timestamp: dds_time(), CLOCK_REALTIME
+  }
+  std::this_thread::sleep_for(300ms);
+  return 0;
+}
+
+/// Cyclone's configuration as net::Participant makes it for "lo" (dds.cpp's domain_config), with
+/// WriteBatch on: samples written go out together at dds_write_flush, a few packets for all
+/// robots instead of one each.
+std::string batched_loopback_config() {
+  return "<CycloneDDS><Domain id=\"any\"><General><Interfaces><NetworkInterface name=\"lo\" "
+         "multicast=\"default\"/></Interfaces></General><Discovery><ParticipantIndex>auto"
+         "</ParticipantIndex><MaxAutoParticipantIndex>40</MaxAutoParticipantIndex><Peers><Peer "
+         "address=\"127.0.0.1\"/></Peers></Discovery><Internal><WriteBatch>true</WriteBatch>"
+         "</Internal></Domain></CycloneDDS>";
+}
+
+/// `robots` robots' RobotState every 1 ms for `seconds`, batched (one flush a period) or one
+/// packet a sample; prints "periods=P late=L write_us=W" (W: mean time writing a period, us).
+int run_fleet_writer(std::uint32_t domain, int robots, long seconds, bool batch) {
+  // The domain made here first with WriteBatch: the Participant then shares it.
+  net::Entity batched_domain;
+  if (batch) {
+    batched_domain = net::Entity(
+        net::check(dds_create_domain(domain, batched_loopback_config().c_str()), "domain"));
+  }
+  const net::Participant p(options(domain, "puma"));
+  const net::Entity w = p.writer(net::Topic::state);
+  if (!wait_for([&] { return writer_matches(w.get()) > 0; }, 30s)) return 2;
+  std::this_thread::sleep_for(300ms);
+  std::vector<rccx_net_RobotState> states(static_cast<std::size_t>(robots));
+  for (int k = 0; k < robots; ++k) {
+    std::snprintf(states[static_cast<std::size_t>(k)].robot, sizeof states[0].robot, "r%d", k);
+    states[static_cast<std::size_t>(k)].dof = 6;
+  }
+  long periods = 0;
+  long late = 0;
+  timespec t{};
+  clock_gettime(CLOCK_MONOTONIC, &t);
+  std::int64_t write_ns = 0;  // time spent writing, all periods
+  // seconds * 1000 periods, or fewer when writing overruns the period: stop at `seconds`.
+  const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(seconds);
+  for (long i = 1; i <= seconds * 1000 && std::chrono::steady_clock::now() < end; ++i) {
+    periods = i;
+    pace(t, 1'000'000);
+    const auto t0 = std::chrono::steady_clock::now();
+    for (rccx_net_RobotState& s : states) {
+      s.sample = static_cast<std::uint64_t>(i);
+      dds_write(w.get(), &s);
+    }
+    if (batch) dds_write_flush(w.get());
+    write_ns += (std::chrono::steady_clock::now() - t0).count();
+    timespec now{};
+    clock_gettime(CLOCK_MONOTONIC, &now);
+    if (now.tv_sec > t.tv_sec || (now.tv_sec == t.tv_sec && now.tv_nsec > t.tv_nsec)) ++late;
+  }
+  std::this_thread::sleep_for(300ms);
+  std::printf("periods=%ld late=%ld write_us=%.1f\n", periods, late,
+              static_cast<double>(write_ns) / 1e3 / static_cast<double>(std::max(periods, 1L)));
+  std::fflush(stdout);
+  return 0;
+}
+
+int run_role(int argc, char** argv) {
+  const std::string_view role = argc > 2 ? argv[2] : "";
+  const auto arg = [&](int i) { return argc > i ? std::strtol(argv[i], nullptr, 10) : 0L; };
+  try {
+    const auto domain = static_cast<std::uint32_t>(arg(3));
+    if (role == "responder") return run_responder(domain);
+    if (role == "state-writer") return run_state_writer(domain, arg(4), arg(5));
+    if (role == "fleet-writer") {
+      return run_fleet_writer(domain, static_cast<int>(arg(4)), arg(5), arg(6) != 0);
+    }
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "net_bench %s: %s\n", std::string(role).c_str(), e.what());
+    return 1;
+  }
+  std::fprintf(stderr, "net_bench: unknown role '%s'\n", std::string(role).c_str());
+  return 1;
+}
+
+// ---- the cases -------------------------------------------------------------------------------
+
+void BM_NetRequestAckRoundtrip(benchmark::State& state) {
+  const std::uint32_t domain = bench_domain();
+  const long roundtrips = env_long("RCCX_BENCH_ROUNDTRIPS", 100'000);
+  for (auto _ : state) {
+    const net::Participant p(options(domain, "program"));
+    const net::Entity requests = endpoint(p, net::Topic::request, true);
+    const net::Entity acks = endpoint(p, net::Topic::ack, false);
+    const DataWait wait(p, acks.get());
+    Child responder({"responder", std::to_string(domain)});
+    if (!wait_for(
+            [&] { return writer_matches(requests.get()) > 0 && reader_matches(acks.get()) > 0; },
+            30s)) {
+      state.SkipWithError("the responder did not match in 30 s");
+      return;
+    }
+    rccx_net_MotionRequest req{};
+    net::copy_to(req.robot, "puma");
+    net::copy_to(req.program, "bench");
+    req.kind = static_cast<std::uint8_t>(net::RequestKind::move);
+    std::vector<std::int64_t> ns;
+    ns.reserve(static_cast<std::size_t>(roundtrips));
+    const long warmup = 2000;
+    for (long i = 1; i <= warmup + roundtrips; ++i) {
+      req.request = static_cast<std::uint64_t>(i);
+      const auto t0 = std::chrono::steady_clock::now();
+      dds_write(requests.get(), &req);
+      bool acked = false;
+      while (!acked) {
+        if (!wait.wait(DDS_SECS(2))) {
+          state.SkipWithError("no acknowledgement in 2 s");
+          return;
+        }
+        void* buf[4] = {};
+        dds_sample_info_t info[4];
+        const dds_return_t n = dds_take(acks.get(), buf, info, 4, 4);
+        for (dds_return_t k = 0; k < n; ++k) {
+          acked = acked || (info[k].valid_data &&
+                            static_cast<const rccx_net_MotionAck*>(buf[k])->request == req.request);
+        }
+        if (n > 0) dds_return_loan(acks.get(), buf, n);
+      }
+      const auto t1 = std::chrono::steady_clock::now();
+      if (i > warmup) ns.push_back((t1 - t0).count());
+    }
+    set_latency_counters(state, ns);
+    state.counters["responder_is_stand_in"] = 1;
+  }
+}
+BENCHMARK(BM_NetRequestAckRoundtrip)->Iterations(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_NetStateOneWay(benchmark::State& state) {
+  const std::uint32_t domain = bench_domain();
+  const long count = env_long("RCCX_BENCH_ROUNDTRIPS", 100'000) * 11 / 10;
+  const long rate_hz = 10'000;
+  for (auto _ : state) {
+    const net::Participant p(options(domain, "program"));
+    const net::Entity states = p.reader(net::Topic::state);
+    const DataWait wait(p, states.get());
+    Child writer(
+        {"state-writer", std::to_string(domain), std::to_string(count), std::to_string(rate_hz)});
+    std::vector<std::int64_t> ns;
+    ns.reserve(static_cast<std::size_t>(count));
+    std::uint64_t last = 0;
+    long lost = 0;
+    const auto limit =
+        std::chrono::steady_clock::now() + 30s + std::chrono::seconds(count / rate_hz);
+    while (last < static_cast<std::uint64_t>(count) && std::chrono::steady_clock::now() < limit) {
+      if (!wait.wait(DDS_MSECS(500))) {
+        if (last > 0) break;  // the writer is done or gone
+        continue;
+      }
+      void* buf[8] = {};
+      dds_sample_info_t info[8];
+      const dds_return_t n = dds_take(states.get(), buf, info, 8, 8);
+      const dds_time_t now = dds_time();
+      for (dds_return_t k = 0; k < n; ++k) {
+        if (!info[k].valid_data) continue;
+        const std::uint64_t s = static_cast<const rccx_net_RobotState*>(buf[k])->sample;
+        if (last > 0 && s > last + 1) lost += static_cast<long>(s - last - 1);
+        last = s;
+        ns.push_back(now - info[k].source_timestamp);
+      }
+      if (n > 0) dds_return_loan(states.get(), buf, n);
+    }
+    (void)writer.finish(5s);
+    set_latency_counters(state, ns);
+    state.counters["lost"] = static_cast<double>(lost);
+    state.counters["rate_hz"] = static_cast<double>(rate_hz);
+  }
+}
+BENCHMARK(BM_NetStateOneWay)->Iterations(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void state_fleet(benchmark::State& state, bool batch) {
+  const std::uint32_t domain = bench_domain();
+  const auto robots = static_cast<int>(state.range(0));
+  const long seconds = env_long("RCCX_BENCH_FLEET_SECONDS", 3);
+  for (auto _ : state) {
+    const net::Participant p(options(domain, "program"));
+    const net::Entity states = p.reader(net::Topic::state);
+    const DataWait wait(p, states.get());
+    Child writer({"fleet-writer", std::to_string(domain), std::to_string(robots),
+                  std::to_string(seconds), batch ? "1" : "0"});
+    std::vector<long> received(static_cast<std::size_t>(robots), 0);
+    std::vector<std::uint64_t> last(static_cast<std::size_t>(robots), 0);
+    long gaps = 0;
+    bool started = false;
+    const auto limit = std::chrono::steady_clock::now() + 40s + std::chrono::seconds(seconds);
+    while (std::chrono::steady_clock::now() < limit) {
+      if (!wait.wait(DDS_MSECS(500))) {
+        if (started) break;  // the writer is done or gone
+        continue;
+      }
+      started = true;
+      void* buf[256] = {};
+      dds_sample_info_t info[256];
+      const dds_return_t n = dds_take(states.get(), buf, info, 256, 256);
+      for (dds_return_t k = 0; k < n; ++k) {
+        if (!info[k].valid_data) continue;
+        const auto* s = static_cast<const rccx_net_RobotState*>(buf[k]);
+        const long r = std::strtol(s->robot + 1, nullptr, 10);
+        if (r < 0 || r >= robots) continue;
+        const auto i = static_cast<std::size_t>(r);
+        if (last[i] > 0 && s->sample > last[i] + 1)
+          gaps += static_cast<long>(s->sample - last[i] - 1);
+        last[i] = s->sample;
+        ++received[i];
+      }
+      if (n > 0) dds_return_loan(states.get(), buf, n);
+    }
+    const std::string said = writer.finish(5s);
+    long periods = 0;
+    long late = 0;
+    double write_us = 0.0;
+    if (std::sscanf(said.c_str(), "periods=%ld late=%ld write_us=%lf", &periods, &late,
+                    &write_us) != 3) {
+      state.SkipWithError("the fleet writer did not finish (see its stderr)");
+      return;
+    }
+    long lost = 0;
+    long robots_with_loss = 0;
+    for (const long got : received) {
+      lost += periods - got;
+      robots_with_loss += got < periods ? 1 : 0;
+    }
+    state.counters["robots"] = robots;
+    state.counters["periods"] = static_cast<double>(periods);
+    state.counters["late_periods"] = static_cast<double>(late);
+    state.counters["write_us_per_period"] = write_us;
+    state.counters["lost"] = static_cast<double>(lost);
+    state.counters["gaps_seen"] = static_cast<double>(gaps);
+    state.counters["robots_with_loss"] = static_cast<double>(robots_with_loss);
+    state.counters["no_loss"] = lost == 0 && late == 0 ? 1 : 0;
+  }
+}
+void BM_NetStateFleet(benchmark::State& state) {
+  state_fleet(state, false);
+}
+void BM_NetStateFleetBatched(benchmark::State& state) {
+  state_fleet(state, true);
+}
+BENCHMARK(BM_NetStateFleetBatched)
+    ->Arg(64)
+    ->Arg(128)
+    ->Arg(256)
+    ->Arg(512)
+    ->Iterations(1)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK(BM_NetStateFleet)
+    ->Arg(64)
+    ->Arg(128)
+    ->Arg(256)
+    ->Arg(512)
+    ->Iterations(1)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc >= 2 && std::string_view(argv[1]) == "--net-role") return run_role(argc, argv);
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}
