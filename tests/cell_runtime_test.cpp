@@ -422,9 +422,11 @@ class FixedRemote : public cell::RemoteRobotSource {
  public:
   kin::JointVector q;
   double age_s = 0.0;
-  bool latest(std::size_t remote, kin::JointVector& out, double& age) const noexcept override {
+  bool latest(std::size_t remote, kin::JointVector& out, kin::JointVector& qd,
+              double& age) const noexcept override {
     if (remote != 0) return false;
     out = q;
+    qd = kin::JointVector(q.size());  // standing
     age = age_s;
     return true;
   }
@@ -467,13 +469,13 @@ TEST(CellRuntime, AnotherProcesssRobotIsInTheCollisionCheckWithItsStatesAgeInThe
   EXPECT_GE(fresh_m, margin_m) << "the PUMA came within the margin of the remote Microbo";
   EXPECT_NE(fresh_why.find("microbo"), std::string::npos) << fresh_why;
   EXPECT_NE(fresh_why.find("another process's"), std::string::npos) << fresh_why;
-  // A state 100 ms old: the Microbo may have moved since, so the PUMA stops sooner.
-  const auto [old_m, old_travel_m, old_why] = puma_towards_a_remote_microbo(0.1);
+  // A state 300 ms old: the Microbo may have moved since, so the PUMA stops sooner.
+  const auto [old_m, old_travel_m, old_why] = puma_towards_a_remote_microbo(0.3);
   EXPECT_GE(old_m, margin_m);
   EXPECT_LT(old_travel_m, fresh_travel_m - 0.005)
       << "the age did not widen the margin: " << old_why << " (went " << old_travel_m * 1e3
       << " mm against " << fresh_travel_m * 1e3 << " mm)";
-  EXPECT_NE(old_why.find("100 ms old"), std::string::npos) << old_why;
+  EXPECT_NE(old_why.find("300 ms old"), std::string::npos) << old_why;
 }
 
 TEST(CellRuntime, ACellRunsOnlyItsLocalRobotsAndNamesTheOthersAsServedElsewhere) {
@@ -491,8 +493,20 @@ TEST(CellRuntime, ACellRunsOnlyItsLocalRobotsAndNamesTheOthersAsServedElsewhere)
   }
   options.local_robots = {"pumaa"};
   EXPECT_THROW(cell::Cell(cell::load_cell_file(kCvarl), options), std::invalid_argument);
-  // The remote robot's margin grows with its state's age at its joints' top speeds.
-  EXPECT_EQ(c.remote_allowance_m(0, 0.0), 0.0);
-  EXPECT_GT(c.remote_allowance_m(0, 0.1), 0.05);
-  EXPECT_NEAR(c.remote_allowance_m(0, 0.2), 2 * c.remote_allowance_m(0, 0.1), 1e-12);
+  // The remote robot's margin grows with its state's age: from rest, as its acceleration bound
+  // lets it (a t^2 / 2, four times as far in twice the time); moving, by its speed too; never
+  // past its top speed (an unknown speed: the top speed).
+  const std::size_t dof = c.model().find_robot("puma")->model.dof();
+  const kin::JointVector rest(dof);
+  kin::JointVector moving(dof);
+  moving[0] = 0.5;
+  kin::JointVector unknown(dof);
+  for (std::size_t j = 0; j < dof; ++j) unknown[j] = std::nan("");
+  EXPECT_EQ(c.remote_allowance_m(0, rest, 0.0), 0.0);
+  EXPECT_GT(c.remote_allowance_m(0, rest, 0.02), 0.0);
+  EXPECT_NEAR(c.remote_allowance_m(0, rest, 0.02), c.remote_allowance_m(0, rest, 0.01) * 4, 1e-12);
+  EXPECT_GT(c.remote_allowance_m(0, moving, 0.02), c.remote_allowance_m(0, rest, 0.02) + 1e-3);
+  EXPECT_GT(c.remote_allowance_m(0, unknown, 0.02), c.remote_allowance_m(0, moving, 0.02));
+  EXPECT_NEAR(c.remote_allowance_m(0, unknown, 0.2), 2 * c.remote_allowance_m(0, unknown, 0.1),
+              1e-12);
 }

@@ -240,6 +240,12 @@ math::Transform tool_down(double x, double y, double z) {
 
 }  // namespace
 
+std::string failures_text(const std::vector<rccl::MotionEvent>& failures) {
+  std::string s;
+  for (const rccl::MotionEvent& e : failures) s += std::string(e.message()) + "; ";
+  return s;
+}
+
 TEST(NetServe, ProgramMovesRobotsOfAServeAndARefusalThrowsTheServesReason) {
   const std::uint32_t d = domain();
   auto s = serve(d, "puma,microbo", "serve_basic");
@@ -403,7 +409,8 @@ TEST(NetServe, AKilledServeFailsTheProgramsWaitWithinTheDetectionTime) {
   }
   std::this_thread::sleep_for(300ms);  // its request reader matched
   const rccl::Motion back = puma.move(puma.park());
-  EXPECT_EQ(puma.waitfor(back.end(), 20s), rccl::WaitResult::reached);
+  EXPECT_EQ(puma.waitfor(back.end(), 20s), rccl::WaitResult::reached)
+      << failures_text(puma.failures());
 }
 
 TEST(NetServe, AKilledProgramsRobotStopsSmoothlyAndTheServeSaysWhy) {
@@ -474,15 +481,26 @@ TEST(NetServe, ARobotFollowsAnotherProcesssRobotAndStopsWhenThatServeDies) {
   net::RemoteCell cell(cell::load_cell_file(kCell), loopback(d));
   net::RemoteArm& puma = cell.robot("puma");
   net::RemoteArm& microbo = cell.robot("microbo");
-  // The PUMA's tool over the board, pointing down; the Microbo's 60 mm to +x of it.
+  // The PUMA's tool over the board, pointing down; the Microbo's 150 mm to +x of it (as the
+  // one-process CellRuntime.TheMicroboFollowsAFrameThePumaMoves places them: each process's
+  // collision check keeps them apart, the other's state aged by its transit).
   puma.set_mode(rccl::Mode::joint);
-  const rccl::Motion p1 = puma.move(cell.world_goal("puma", "OVER", tool_down(-0.03, 0.0, 0.19)));
+  puma.set_velocity(0.05, 0.5);  // joint moves slow enough near the other arm
+  microbo.set_velocity(0.05, 0.5);
+  const rccl::Motion p1 = puma.move(cell.world_goal("puma", "OVER", tool_down(-0.05, 0.0, 0.1516)));
+  const rccl::Motion m0 =
+      microbo.move(cell.world_goal("microbo", "M0", tool_down(0.10, 0.0, 0.1516)));
+  ASSERT_EQ(microbo.waitfor(m0.end(), 20s), rccl::WaitResult::reached) << [&] {
+    std::string s;
+    for (const auto& e : microbo.failures()) s += std::string(e.message()) + "; ";
+    return s;
+  }();
   ASSERT_EQ(puma.waitfor(p1.end(), 20s), rccl::WaitResult::reached) << [&] {
     std::string s;
     for (const auto& e : puma.failures()) s += std::string(e.message()) + "; ";
     return s + "\nleader's serve: " + sp->err() + "\nfollower's serve: " + sm->err();
   }();
-  const auto offset = rccl::constant("BESIDE", math::Transform::translation(0.06, 0, 0));
+  const auto offset = rccl::constant("BESIDE", math::Transform::translation(0.15, 0, 0));
   microbo.set_mode(rccl::Mode::joint);
   const rccl::Motion f1 =
       microbo.move(cell.world_goal("microbo", "FOLLOW", {cell.tool_frame("puma"), offset}));
@@ -500,14 +518,15 @@ TEST(NetServe, ARobotFollowsAnotherProcesssRobotAndStopsWhenThatServeDies) {
   // The PUMA moves 30 mm along y, slowly; the Microbo's tool tracks it.
   puma.set_mode(rccl::Mode::cartesian);
   puma.set_velocity(0.02, 0.3);
-  const rccl::Motion p2 = puma.move(cell.world_goal("puma", "ASIDE", tool_down(-0.03, 0.03, 0.19)));
+  const rccl::Motion p2 =
+      puma.move(cell.world_goal("puma", "ASIDE", tool_down(-0.05, 0.03, 0.1516)));
   double worst_mm = 0.0;
   rccl::WaitResult moved = rccl::WaitResult::timeout;
   const auto until = std::chrono::steady_clock::now() + 20s;
   while (std::chrono::steady_clock::now() < until &&
          (moved = puma.waitfor(p2.end(), 20ms)) == rccl::WaitResult::timeout) {
     const net::RemoteState a = puma.state(), b = microbo.state();
-    const math::Vec3 want = a.tool.pose.p + math::Vec3{0.06, 0, 0};
+    const math::Vec3 want = a.tool.pose.p + math::Vec3{0.15, 0, 0};
     worst_mm = std::max(worst_mm, (b.tool.pose.p - want).norm() * 1e3);
   }
   ASSERT_EQ(moved, rccl::WaitResult::reached) << [&] {
@@ -519,7 +538,7 @@ TEST(NetServe, ARobotFollowsAnotherProcesssRobotAndStopsWhenThatServeDies) {
   std::printf("the Microbo tracked the PUMA's tool (other process) within %.2f mm\n", worst_mm);
   EXPECT_LT(worst_mm, 5.0);
   // Now the PUMA moves back and its serve dies mid-motion: the Microbo stops smoothly.
-  (void)puma.move(cell.world_goal("puma", "BACK", tool_down(-0.03, -0.03, 0.19)));
+  (void)puma.move(cell.world_goal("puma", "BACK", tool_down(-0.05, -0.03, 0.1516)));
   std::this_thread::sleep_for(600ms);
   const std::int64_t killed = now_ns();
   sp->kill9();

@@ -210,13 +210,17 @@ Cell::Cell(CellModel model, CellOptions options)
     if (local(cr.name)) continue;
     remote_names_.push_back(cr.name);
     remote_model_index_.push_back(i);
-    const kin::JointVector lever = levers_m(cr);
-    double speed = 0.0;
+    kin::JointVector factor = levers_m(cr);
+    kin::JointVector v_max(cr.model.dof()), a_max(cr.model.dof());
     for (std::size_t j = 0; j < cr.model.dof(); ++j) {
-      const double factor = cr.model.joints[j].type == kin::JointType::prismatic ? 1.0 : lever[j];
-      speed += factor * cr.model.joints[j].max_velocity;
+      if (cr.model.joints[j].type == kin::JointType::prismatic) factor[j] = 1.0;
+      // The generator's defaults (rccl::GeneratorOptions), as its own process runs it.
+      v_max[j] = cr.model.joints[j].max_velocity;
+      a_max[j] = v_max[j] / rccl::kDefaultAccelerationTime_s;
     }
-    remote_point_speed_m_per_s_.push_back(speed);
+    remote_travel_factor_.push_back(factor);
+    remote_max_velocity_.push_back(v_max);
+    remote_max_acceleration_.push_back(a_max);
     add_capsules(model_, cr, capsules);
   }
   std::vector<Solid> solids;
@@ -511,7 +515,7 @@ void Cell::on_cycle(std::uint32_t tick) noexcept {
       r.fresh = false;
     }
   }
-  if (!remote_names_.empty()) place_remote_robots(tick);
+  if (!remote_names_.empty()) place_remote_robots();
   if (options_.collision_checks) check_collisions();
   publish_ledgers();
   if (observer_) observer_(tick);
@@ -569,25 +573,34 @@ void Cell::set_remote_source(const RemoteRobotSource* source) {
   remote_source_ = source;
 }
 
-double Cell::remote_allowance_m(std::size_t remote, double age_s) const noexcept {
-  if (remote >= remote_point_speed_m_per_s_.size() || !(age_s > 0.0)) return 0.0;
+double Cell::remote_allowance_m(std::size_t remote, const kin::JointVector& qd,
+                                double age_s) const noexcept {
+  if (remote >= remote_travel_factor_.size() || !(age_s > 0.0)) return 0.0;
+  const kin::JointVector& factor = remote_travel_factor_[remote];
+  const kin::JointVector& v_max = remote_max_velocity_[remote];
+  const kin::JointVector& a_max = remote_max_acceleration_[remote];
+  double travel = 0.0;
+  for (std::size_t j = 0; j < factor.size(); ++j) {
+    const double v = j < qd.size() && std::isfinite(qd[j]) ? std::abs(qd[j]) : v_max[j];
+    const double joint = std::min(v * age_s + 0.5 * a_max[j] * age_s * age_s, v_max[j] * age_s);
+    travel += factor[j] * joint;
+  }
   // Beyond 10 m it stops everything near anyway; the cap keeps the sums finite.
-  return std::min(remote_point_speed_m_per_s_[remote] * age_s, 10.0);
+  return std::min(travel, 10.0);
 }
 
-void Cell::place_remote_robots(std::uint32_t tick) noexcept {
+void Cell::place_remote_robots() noexcept {
   const std::size_t local = robots_.size();
-  // Never heard of: anywhere it could have gone since the cell started.
-  const double since_start_s =
-      static_cast<double>(tick) * std::chrono::duration<double>(group_->period()).count();
   for (std::size_t k = 0; k < remote_names_.size(); ++k) {
-    kin::JointVector q;
-    double age = since_start_s;
-    if (remote_source_ != nullptr && remote_source_->latest(k, q, age)) {
+    kin::JointVector q, qd;
+    double age = 0.0;
+    // A robot no process has served yet stands at its ready pose (nothing commands it); once
+    // heard of, it may have moved at its top speed for as long as its state is old.
+    if (remote_source_ != nullptr && remote_source_->latest(k, q, qd, age)) {
       world_->set_configuration(local + k, q);
     }
     remote_age_s_[k] = age;
-    world_->set_allowance(local + k, remote_allowance_m(k, age));
+    world_->set_allowance(local + k, remote_allowance_m(k, qd, age));
   }
 }
 

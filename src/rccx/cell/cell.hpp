@@ -93,8 +93,9 @@ class RemoteRobotSource {
  public:
   virtual ~RemoteRobotSource() = default;
   /// Remote robot `remote` (an index of Cell::remote_names()): its newest commanded joints
-  /// (rad / m) and their age now (s). False when none has come yet.
-  virtual bool latest(std::size_t remote, kin::JointVector& q, double& age_s) const noexcept = 0;
+  /// (rad / m), their speeds (rad/s / m/s) and their age now (s). False when none has come yet.
+  virtual bool latest(std::size_t remote, kin::JointVector& q, kin::JointVector& qd,
+                      double& age_s) const noexcept = 0;
 };
 
 /// Motions of several robots that start in the same sample (Cell::together).
@@ -151,12 +152,16 @@ class Cell : public Workcell {
     return remote_names_;
   }
   /// Where the remote robots' states come from (kept by the caller while the cell runs);
-  /// before start() only. Without one, a remote robot stays at its ready pose with a margin
-  /// that grows with the time since start: it soon stops any robot that approaches it.
+  /// before start() only. A remote robot no state has come for yet (none served it so far,
+  /// nothing commands it) stands at its ready pose; once heard of, its margin grows with its
+  /// newest state's age (remote_allowance_m).
   void set_remote_source(const RemoteRobotSource* source);
-  /// How far any point of a remote robot may have moved in `age_s` (s): the allowance its
-  /// capsules get in the collision check (its joints' top speeds times their levers), m.
-  [[nodiscard]] double remote_allowance_m(std::size_t remote, double age_s) const noexcept;
+  /// How far any point of a remote robot may have moved in `age_s` (s) since a state that
+  /// gave its joints' speeds `qd`: each joint at most |qd| age + a age^2 / 2 (a its generator's
+  /// acceleration bound), never beyond its top speed times age, times its lever; m. The
+  /// allowance its capsules get in the collision check.
+  [[nodiscard]] double remote_allowance_m(std::size_t remote, const kin::JointVector& qd,
+                                          double age_s) const noexcept;
   /// Closes every robot's session, its RCCX_LOG log put in place (one file a robot, named by its
   /// name in the cell). True when every log is whole (or there is none); a lost one (a full
   /// disk, an I/O error) is said on stderr as "<program>: robot <name>'s sample log is lost: ..."
@@ -273,7 +278,7 @@ class Cell : public Workcell {
   void check_collisions() noexcept;
   /// Places the remote robots in the collision world from their newest states, each with the
   /// allowance its state's age calls for.
-  void place_remote_robots(std::uint32_t tick) noexcept;
+  void place_remote_robots() noexcept;
   /// Throws CellFileError when a robot's ready pose lies inside an object it may not touch.
   void check_clear_at_start() const;
   void publish_ledgers() noexcept;
@@ -282,12 +287,13 @@ class Cell : public Workcell {
   CellOptions options_;
   // Declared before the group: the cycle hook uses them until the group's tasks stop.
   std::vector<std::unique_ptr<Robot>> robots_;
-  /// Remote robots: their names, model indices and point-speed bounds (m/s: a point of the
-  /// arm moves at most this fast at the joints' top speeds); their collision-world indices
-  /// follow the local robots'.
+  /// Remote robots: their names, model indices and what bounds their travel (levers, top
+  /// speeds, acceleration bounds); their collision-world indices follow the local robots'.
   std::vector<std::string> remote_names_;
   std::vector<std::size_t> remote_model_index_;
-  std::vector<double> remote_point_speed_m_per_s_;
+  std::vector<kin::JointVector> remote_travel_factor_;     ///< m per rad (1 per m prismatic)
+  std::vector<kin::JointVector> remote_max_velocity_;      ///< rad/s / m/s
+  std::vector<kin::JointVector> remote_max_acceleration_;  ///< the generator's bound
   const RemoteRobotSource* remote_source_ = nullptr;
   std::vector<double> remote_age_s_;  ///< control task: each remote state's age at the last tick
   /// Each robot's generator, side by side, so that the tick's last pass can fetch the next

@@ -63,6 +63,12 @@ bool RobotMirror::apply(const rccx_net_RobotState& s, std::int64_t steady) noexc
   f.angular_velocity_rad_s = {s.angular_velocity[0], s.angular_velocity[1], s.angular_velocity[2]};
   f.stamp_ns = s.stamp_ns;
   frame.store(f);
+  JointsSample j;
+  const std::size_t dof = std::min<std::size_t>(s.dof, kin::kMaxJoints);
+  j.q = kin::JointVector(std::span<const double>(s.q_commanded, dof));
+  j.qd = kin::JointVector(std::span<const double>(s.qd_commanded, dof));
+  j.received_ns = steady;
+  joints.store(j);
   // Failures before the counters, so that a reader never sees a failed motion as ended.
   for (int k = 3; k >= 0; --k) {
     const std::uint64_t from = s.failed_from[k], to = s.failed_to[k];

@@ -14,6 +14,7 @@
 #include <string>
 
 #include "rccx/cell/seqlock.hpp"
+#include "rccx/kinematics/joint_vector.hpp"
 #include "rccx/math/transform.hpp"
 #include "rccx/rccl/motion_sync.hpp"
 #include "rccx/rccl/transforms.hpp"
@@ -39,7 +40,15 @@ struct FrameState {
                                               const cell::SeqLock<FrameState>* source,
                                               std::chrono::nanoseconds max_extrapolation);
 
-/// One remote robot: its newest frame and ledger, and whether it is alive.
+/// A remote robot's newest commanded joints (rad / m) and when they came (steady clock, ns):
+/// what the collision check places its capsules from.
+struct JointsSample {
+  kin::JointVector q;
+  kin::JointVector qd;  ///< rad/s / m/s
+  std::int64_t received_ns = 0;
+};
+
+/// One remote robot: its newest frame, joints and ledger, and whether it is alive.
 class RobotMirror {
  public:
   explicit RobotMirror(std::string_view robot) : ledger(robot), name_(robot) {}
@@ -67,6 +76,7 @@ class RobotMirror {
   [[nodiscard]] std::uint64_t instance() const noexcept { return instance_; }
 
   cell::SeqLock<FrameState> frame;
+  cell::SeqLock<JointsSample> joints;
   rccl::MotionLedger ledger;
 
  private:

@@ -300,18 +300,39 @@ rccl::WaitResult RemoteArm::waitfor(const rccl::Event& event, std::chrono::nanos
   }
 }
 
-void RemoteArm::wait_for(std::chrono::nanoseconds d) {
+rtc::Termination RemoteArm::wait_for(std::chrono::nanoseconds d) {
   std::this_thread::sleep_for(d);
+  rtc::Termination t;
+  std::lock_guard lock(cell_.mutex_);
+  if (state_ && state_->terminate_code != 0) {
+    t.code = static_cast<rtc::TerminateCode>(state_->terminate_code);
+    t.sample = state_->sample;
+    t.time_s = state_->t_s;
+    const std::string_view why(state_->termination);
+    const std::size_t n = std::min(why.size(), t.message.size() - 1);
+    std::copy_n(why.data(), n, t.message.data());
+  }
+  return t;
 }
 
-bool RemoteArm::happened(const rccl::Event& event) const {
+bool RemoteArm::happened(const rccl::Event& event) const noexcept {
   std::lock_guard lock(cell_.mutex_);
   return answer(event) == rccl::GateAnswer::yes;
 }
 
-std::vector<rccl::MotionEvent> RemoteArm::failures() const {
+const std::vector<rccl::MotionEvent>& RemoteArm::failures() {
   std::lock_guard lock(cell_.mutex_);
-  return failures_;
+  failures_copy_ = failures_;
+  return failures_copy_;
+}
+
+rccl::SegmentReport RemoteArm::report(const rccl::Motion& m) const noexcept {
+  std::lock_guard lock(cell_.mutex_);
+  const auto it = reports_.find(m.id);
+  if (it != reports_.end()) return it->second;
+  rccl::SegmentReport r;
+  r.id = m.id;
+  return r;
 }
 
 std::vector<rccl::MotionEvent> RemoteArm::take_events() {
@@ -449,6 +470,10 @@ RemoteCell::RemoteCell(cell::CellModel model, NetOptions net, RemoteOptions opti
   for (auto& a : arms_) a->last_queued_ = a->state_->queued;
 }
 
+void RemoteCell::start() {
+  for (auto& a : arms_) a->attach();
+}
+
 RemoteCell::~RemoteCell() {
   stop_.store(true);
   if (thread_.joinable()) thread_.join();
@@ -474,41 +499,9 @@ std::vector<std::string> RemoteCell::robot_names() const {
   return v;
 }
 
-const cell::CellRobot& RemoteCell::model_robot(std::string_view name) const {
-  const cell::CellRobot* r = model_.find_robot(name);
-  if (r == nullptr) {
-    throw std::invalid_argument(fmt::format("cell {} has no robot \"{}\"; its robots are: {}",
-                                            model_.name, name, robots_of(model_)));
-  }
-  return *r;
-}
-
-rccl::TransformPtr RemoteCell::tool_frame(std::string_view leader) {
-  RemoteArm& a = robot(leader);
+rccl::TransformPtr RemoteCell::tool_frame(std::string_view leader) const {
+  RemoteArm& a = const_cast<RemoteCell*>(this)->robot(leader);  // its mirror outlives the frame
   return remote_frame(a.name() + "_TOOL", "frame:" + a.name(), &a.mirror_->frame, net_.detection);
-}
-
-rccl::TransformPtr RemoteCell::tool_transform(std::string_view robot) const {
-  const cell::CellRobot& r = model_robot(robot);
-  return rccl::constant(r.name + "_TOOL", r.tool.value_or(math::Transform::identity()));
-}
-
-rccl::TransformPtr RemoteCell::base_inv_transform(std::string_view robot) const {
-  const cell::CellRobot& r = model_robot(robot);
-  return rccl::constant(r.name + "_BASE_INV", r.base.inverse());
-}
-
-rccl::PositionPtr RemoteCell::world_goal(std::string_view robot, std::string name,
-                                         const std::vector<rccl::TransformPtr>& world) const {
-  std::vector<rccl::TransformPtr> rhs{base_inv_transform(robot)};
-  rhs.insert(rhs.end(), world.begin(), world.end());
-  return rccl::Position::make(std::move(name), {rccl::t6(), tool_transform(robot)}, rhs);
-}
-
-rccl::PositionPtr RemoteCell::world_goal(std::string_view robot, std::string name,
-                                         const math::Transform& world_pose) const {
-  auto goal = rccl::constant(name, world_pose);
-  return world_goal(robot, std::move(name), {std::move(goal)});
 }
 
 rccl::TransformPtr RemoteCell::function(std::string name) const {
@@ -547,12 +540,6 @@ rccl::EventGate RemoteCell::event(std::string_view robot_name, const rccl::Event
           "a position's end cannot gate another robot; use the motion's end (m.end())");
   }
   return g;
-}
-
-rccl::StartWhen RemoteCell::after(std::string_view robot_name, const rccl::Event& e) {
-  rccl::StartWhen w;
-  w.after.push_back(event(robot_name, e));
-  return w;
 }
 
 rccl::WaitResult RemoteCell::waitfor(const std::vector<rccl::EventGate>& gates,
@@ -658,6 +645,12 @@ void RemoteCell::poll(std::int64_t now) {
         if (a == nullptr) continue;
         const rccl::MotionEvent e = to_event(buf[i]);
         std::lock_guard lock(mutex_);
+        rccl::SegmentReport& r = a->reports_[e.id];
+        r.id = e.id;
+        if (e.kind == rccl::EventKind::started) r.start_s = e.t_s;
+        if (e.kind != rccl::EventKind::started) r.end_s = e.t_s;
+        r.failed = e.kind == rccl::EventKind::failed || e.kind == rccl::EventKind::cancelled;
+        if (a->reports_.size() > 4096) a->reports_.erase(a->reports_.begin());
         a->events_.push_back(e);
         if (a->events_.size() > 4096) a->events_.erase(a->events_.begin());
         if (e.kind == rccl::EventKind::failed || e.kind == rccl::EventKind::cancelled) {

@@ -31,9 +31,11 @@
 
 #include "rccx/cell/cell.hpp"
 #include "rccx/cell/cell_model.hpp"
+#include "rccx/cell/workcell.hpp"
 #include "rccx/kinematics/kinematics.hpp"
 #include "rccx/net/dds.hpp"
 #include "rccx/net/mirror.hpp"
+#include "rccx/rccl/arm.hpp"
 #include "rccx/rccl/manipulator.hpp"
 
 namespace rccx::net {
@@ -73,7 +75,7 @@ struct RemoteOptions {
 };
 
 /// One robot of a RemoteCell, with the Manipulator's calls.
-class RemoteArm {
+class RemoteArm : public rccl::Arm {
  public:
   RemoteArm(RemoteCell& cell, const cell::CellRobot& robot);
   RemoteArm(const RemoteArm&) = delete;
@@ -82,54 +84,55 @@ class RemoteArm {
   [[nodiscard]] const std::string& name() const noexcept { return name_; }
 
   // --- Settings for the motions queued from now on (sent with each motion) ---------------
-  void set_mode(rccl::Mode mode) noexcept { settings_.mode = mode; }
+  void set_mode(rccl::Mode mode) override { settings_.mode = mode; }
   /// m/s, rad/s, both > 0 (MotionError otherwise, nothing changed).
-  void set_velocity(double translation_m_per_s, double rotation_rad_per_s);
-  void set_segment_time(double seconds);
-  void set_transition_time(double seconds);
+  void set_velocity(double translation_m_per_s, double rotation_rad_per_s) override;
+  void set_segment_time(double seconds) override;
+  void set_transition_time(double seconds) override;
   /// A name of the robot's configurations ("lun" ...); empty keeps the present one.
-  void set_configuration(std::string_view name);
-  void set_guard(const rccl::ForceGuard& guard);
-  void set_compliance(const rccl::Compliance& compliance);
-  [[nodiscard]] const rccl::MotionSettings& settings() const noexcept { return settings_; }
+  void set_configuration(std::string_view name) override;
+  void set_guard(const rccl::ForceGuard& guard) override;
+  void set_compliance(const rccl::Compliance& compliance) override;
+  [[nodiscard]] const rccl::MotionSettings& settings() const noexcept override { return settings_; }
 
   // --- Requests: each waits for the serve process's answer ------------------------------
   /// Queues a motion; throws rccl::MotionError with the serve's reason when it is refused,
   /// when the serve does not answer in time, when the robot is lost, or for a position that
   /// cannot be sent (a functional transform without a network name).
-  rccl::Motion move(const rccl::PositionPtr& position, const rccl::StartWhen& when = {});
-  rccl::Motion dwell(double seconds, const rccl::StartWhen& when = {});
+  rccl::Motion move(const rccl::PositionPtr& position, const rccl::StartWhen& when = {}) override;
+  rccl::Motion dwell(double seconds, const rccl::StartWhen& when = {}) override;
   /// Stops smoothly where the arm is and cancels everything queued.
-  void halt();
+  void halt() override;
   /// RCCL's nextmove: ends the running motion where the arm is; the queue goes on.
   void nextmove();
-  void set_hand(bool closed);
+  void set_hand(bool closed) override;
   /// Takes the robot for this program without moving it: its loss now stops the robot.
   void attach();
 
   // --- Waiting and what happened ----------------------------------------------------------
   /// The robot's ready pose, in joints.
-  [[nodiscard]] const rccl::PositionPtr& park() const noexcept { return park_; }
-  [[nodiscard]] static rccl::Event completed() noexcept { return {}; }
-  [[nodiscard]] static rccl::Event ended(const rccl::PositionPtr& p) noexcept {
-    return {rccl::Event::Kind::position_end, 0, p.get()};
-  }
+  [[nodiscard]] const rccl::PositionPtr& park() const noexcept override { return park_; }
   /// Waits (real time) for `event`: reached; failed when its motion failed or was cancelled,
   /// control ended, or the robot was lost (failures() says why); timeout.
   rccl::WaitResult waitfor(const rccl::Event& event,
-                           std::chrono::nanoseconds timeout = std::chrono::hours(24));
-  /// Lets `d` pass (real time).
-  void wait_for(std::chrono::nanoseconds d);
-  [[nodiscard]] bool happened(const rccl::Event& event) const;
-  /// Failures and cancellations so far (from the events), and the robot's loss.
-  [[nodiscard]] std::vector<rccl::MotionEvent> failures() const;
+                           std::chrono::nanoseconds timeout = std::chrono::hours(24)) override;
+  /// Lets `d` pass (real time). Returns how control ended (from the robot's state: its
+  /// terminate code and reason) if it has ended, an empty one otherwise.
+  rtc::Termination wait_for(std::chrono::nanoseconds d) override;
+  [[nodiscard]] bool happened(const rccl::Event& event) const noexcept override;
+  /// Failures and cancellations so far (from the events), and the robot's loss. The reference
+  /// stays valid until the next call.
+  [[nodiscard]] const std::vector<rccl::MotionEvent>& failures() override;
   /// Every event received since the last call.
-  std::vector<rccl::MotionEvent> take_events();
+  std::vector<rccl::MotionEvent> take_events() override;
+  /// When motion `m` started and ended (the serve's clock, s) and whether it failed, from its
+  /// events; the path errors of a local report are not sent.
+  [[nodiscard]] rccl::SegmentReport report(const rccl::Motion& m) const noexcept override;
   /// The last motion queued on the robot (by this program, or as its state said at start).
-  [[nodiscard]] std::uint64_t last_queued() const noexcept { return last_queued_; }
+  [[nodiscard]] std::uint64_t last_queued() const noexcept override { return last_queued_; }
   /// The newest state and its age. Throws rccl::MotionError before any.
   [[nodiscard]] RemoteState state() const;
-  [[nodiscard]] const kin::Kinematics& kinematics() const noexcept { return *kinematics_; }
+  [[nodiscard]] const kin::Kinematics& kinematics() const noexcept override { return *kinematics_; }
   /// The ledger kept from the robot's states (gates, waits).
   [[nodiscard]] const RobotMirror& mirror() const noexcept { return *mirror_; }
 
@@ -153,6 +156,9 @@ class RemoteArm {
   std::optional<rccx_net_RobotState> state_;
   std::int64_t state_received_ns_ = 0;
   std::vector<rccl::MotionEvent> events_, failures_;
+  std::vector<rccl::MotionEvent> failures_copy_;  ///< program side: what failures() returned
+  /// Program side's record of each motion's start and end times (s) from its events.
+  std::map<std::uint64_t, rccl::SegmentReport> reports_;
   std::string lost_;  ///< why the robot is lost ("" while it is alive)
 };
 
@@ -174,44 +180,39 @@ class FrameStream {
   rccl::TransformPtr transform_;
 };
 
-class RemoteCell {
+class RemoteCell : public cell::Workcell {
  public:
   /// Joins the domain, heartbeats, and waits for every robot's state (NetError naming the
   /// robot and the serve command to start when one does not come).
   RemoteCell(cell::CellModel model, NetOptions net = {}, RemoteOptions options = {});
   /// Stops the middleware thread (the serve processes then see this program lost).
-  ~RemoteCell();
+  ~RemoteCell() override;
   RemoteCell(const RemoteCell&) = delete;
   RemoteCell& operator=(const RemoteCell&) = delete;
 
   /// Throws std::invalid_argument naming the robots for an unknown name.
-  [[nodiscard]] RemoteArm& robot(std::string_view name);
-  [[nodiscard]] std::vector<std::string> robot_names() const;
-  [[nodiscard]] const cell::CellModel& model() const noexcept { return model_; }
+  [[nodiscard]] RemoteArm& robot(std::string_view name) override;
+  [[nodiscard]] std::vector<std::string> robot_names() const override;
+  [[nodiscard]] const cell::CellModel& model() const noexcept override { return model_; }
+  /// Attaches this program to every robot (kind attach): from now on, its loss stops them.
+  void start() override;
   [[nodiscard]] const std::string& participant() const noexcept { return participant_name_; }
   [[nodiscard]] const NetOptions& net() const noexcept { return net_; }
 
   // --- Frames (as cell::Cell has them) -------------------------------------------------
   /// `leader`'s commanded T6 TOOL in the world, reference "frame:<leader>"; locally its newest
   /// state's tool pose.
-  [[nodiscard]] rccl::TransformPtr tool_frame(std::string_view leader);
-  [[nodiscard]] rccl::TransformPtr tool_transform(std::string_view robot) const;
-  [[nodiscard]] rccl::TransformPtr base_inv_transform(std::string_view robot) const;
-  [[nodiscard]] rccl::PositionPtr world_goal(std::string_view robot, std::string name,
-                                             const std::vector<rccl::TransformPtr>& world) const;
-  [[nodiscard]] rccl::PositionPtr world_goal(std::string_view robot, std::string name,
-                                             const math::Transform& world_pose) const;
+  [[nodiscard]] rccl::TransformPtr tool_frame(std::string_view leader) const override;
   /// A function registered in the serve processes ("function:<name>"); locally the identity.
   [[nodiscard]] rccl::TransformPtr function(std::string name) const;
   /// A stream this program writes ("stream:<name>").
   [[nodiscard]] FrameStream& stream(std::string name);
 
   // --- Synchronisation -----------------------------------------------------------------
-  [[nodiscard]] rccl::EventGate event(std::string_view robot, const rccl::Event& e);
-  [[nodiscard]] rccl::StartWhen after(std::string_view robot, const rccl::Event& e);
+  [[nodiscard]] rccl::EventGate event(std::string_view robot, const rccl::Event& e) override;
   rccl::WaitResult waitfor(const std::vector<rccl::EventGate>& gates,
-                           std::chrono::nanoseconds timeout = std::chrono::hours(24));
-  void wait_for(std::chrono::nanoseconds d);
+                           std::chrono::nanoseconds timeout = std::chrono::hours(24)) override;
+  void wait_for(std::chrono::nanoseconds d) override;
 
  private:
   friend class RemoteArm;
@@ -219,7 +220,6 @@ class RemoteCell {
   void run() noexcept;
   void poll(std::int64_t now);
   [[nodiscard]] RemoteArm* find(std::string_view name) noexcept;
-  [[nodiscard]] const cell::CellRobot& model_robot(std::string_view name) const;
 
   cell::CellModel model_;
   NetOptions net_;

@@ -27,6 +27,7 @@ struct Slot {
   double t_s = 0.0;
   std::uint8_t dof = 0;
   double q[8]{};
+  double qd[8]{};  ///< rad/s / m/s: the setpoints' last difference over the period
   cell::ToolSample tool;
   std::uint64_t running = 0;
   std::int64_t stamp_ns = 0;
@@ -103,6 +104,18 @@ struct RobotServer::Dedup {
   std::uint64_t highest = 0;
   std::deque<rccx_net_MotionAck> acks;  ///< the newest 256 answers
 };
+
+bool RobotServer::MirrorSource::latest(std::size_t remote, kin::JointVector& q,
+                                       kin::JointVector& qd, double& age_s) const noexcept {
+  if (remote >= mirrors.size()) return false;
+  JointsSample j;
+  mirrors[remote]->joints.load(j);
+  if (j.received_ns == 0 || j.q.size() == 0) return false;
+  q = j.q;
+  qd = j.qd;
+  age_s = static_cast<double>(steady_ns() - j.received_ns) * 1e-9;
+  return true;
+}
 
 cell::CellModel served_model(const cell::CellModel& model, const std::vector<std::string>& robots) {
   std::vector<std::string> names;
@@ -273,7 +286,9 @@ void RobotServer::start() {
     cell::CellOptions co;
     co.clock = rtc::ClockKind::real_time;
     co.real_time_scheduling = options_.real_time_scheduling;
-    cell_ = std::make_unique<cell::Cell>(served_model(full_model_, robot_names_), co);
+    // The other robots of the cell stay in the collision check, placed from their states.
+    co.local_robots = robot_names_;
+    cell_ = std::make_unique<cell::Cell>(full_model_, co);
     for (const std::string& name : cell_->robot_names()) {
       auto l = std::make_unique<Local>();
       l->name = name;
@@ -286,6 +301,10 @@ void RobotServer::start() {
     for (const auto& r : full_model_.robots) {
       if (local(r.name) == nullptr) mirrors_[r.name] = std::make_unique<RobotMirror>(r.name);
     }
+    for (const std::string& name : cell_->remote_names()) {
+      remote_source_.mirrors.push_back(mirrors_.at(name).get());
+    }
+    cell_->set_remote_source(&remote_source_);
     cell_->set_cycle_observer([this](std::uint32_t) { on_cycle(); });
     cell_->start();
   } catch (...) {
@@ -319,7 +338,11 @@ void RobotServer::on_cycle() noexcept {
       s.sample = ++l.samples;
       s.t_s = t;
       s.dof = static_cast<std::uint8_t>(std::min<std::size_t>(q.size(), 8));
-      for (std::size_t j = 0; j < s.dof; ++j) s.q[j] = q[j];
+      const kin::JointVector& q0 = l.gen->previous_setpoint();
+      for (std::size_t j = 0; j < s.dof; ++j) {
+        s.q[j] = q[j];
+        s.qd[j] = q0.size() == q.size() ? (q[j] - q0[j]) / l.period_s : 0.0;
+      }
       s.tool = cell_->tool_sample(l.name);  // the seqlock: no lock, no allocation
       s.running = l.gen->last_motion();
       // The setpoint is for two periods after this sample (Manipulator's pipeline).
@@ -685,7 +708,10 @@ void RobotServer::publish_states(std::int64_t now, bool last) {
     s.written_ns = wall_ns();
     s.period_s = l.period_s;
     s.dof = l.slot.dof;
-    for (std::size_t j = 0; j < l.slot.dof; ++j) s.q_commanded[j] = l.slot.q[j];
+    for (std::size_t j = 0; j < l.slot.dof; ++j) {
+      s.q_commanded[j] = l.slot.q[j];
+      s.qd_commanded[j] = l.slot.qd[j];
+    }
     const rtc::How h = l.session->how();
     for (std::size_t j = 0; j < std::min<std::size_t>(h.dof, 8); ++j) {
       s.q_measured[j] = h.q()[j];

@@ -125,10 +125,18 @@ class RobotServer {
       request_reader_, ack_writer_, event_writer_, frame_reader_;
   std::vector<rccx_net_Claim> claims_;
 
-  std::unique_ptr<cell::Cell> cell_;
   std::vector<std::unique_ptr<Local>> locals_;
   std::map<std::string, std::unique_ptr<RobotMirror>> mirrors_;  ///< the cell's other robots
+  /// The other robots' newest joints for the collision check (cell::RemoteRobotSource).
+  struct MirrorSource : cell::RemoteRobotSource {
+    std::vector<const RobotMirror*> mirrors;  ///< by Cell::remote_names() index
+    bool latest(std::size_t remote, kin::JointVector& q, kin::JointVector& qd,
+                double& age_s) const noexcept override;
+  };
+  MirrorSource remote_source_;
   std::map<std::string, std::unique_ptr<Stream>> streams_;
+  /// After what its cycle observer, remote source and streams read: it (its tasks) goes first.
+  std::unique_ptr<cell::Cell> cell_;
   std::map<std::string, Program> programs_;
   std::map<std::string, std::unique_ptr<Dedup>> dedup_;  ///< by "<program>|<robot>"
 
