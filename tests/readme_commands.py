@@ -53,6 +53,10 @@ TABLE = {
     "make demo": Expect(0, WASHER),
     "make demo-cell": Expect(0, r"^8 pads probed, \d+ on the moving board"),
     "make demo-view": Expect(130, ADDRESS, serve=True),
+    "rccx serve --cell cells/cvarl.json --robots puma --interface lo --seconds 2":
+        Expect(0, r"^rccx serve: stopped; robots halted, claims given back"),
+    "rccx certs init certs --participants puma,microbo,program":
+        Expect(0, r"^program: certs/program/cert\.pem"),
     "make test": Expect(0, "", skip="it is what runs this test (ctest)"),
     "rccx kin robots": Expect(0, r"^puma560 - Unimation PUMA 560"),
     "rccx kin fk --robot puma560 0 0.7854 -3.1416 0 0.7854 0 --json":
