@@ -167,7 +167,7 @@ TRSF_PTR rccl_newtrans(const char* name, int type, RCCL_FN fn);
 #define RCCL_NT_FN_hold ~, RCCL_FN_NULL
 #define RCCL_NT_FN_HOLD ~, RCCL_FN_NULL
 #define RCCL_NT_FN_RCCL_HOLD ~, RCCL_FN_NULL
-#define newtrans(name, type)                                              \
+#define newtrans(name, type)                                          \
   rccl_newtrans((name), RCCL_NT_2ND_(RCCL_NT_TYPE_##type, RCCL_FUNCT, ~), \
                 RCCL_NT_2ND_(RCCL_NT_FN_##type, RCCL_FN_CAST(type), ~))
 
@@ -198,8 +198,8 @@ TRSF_PTR gentr_eul(const char* name, double x_mm, double y_mm, double z_mm, doub
                    double theta_deg, double psi_deg);
 TRSF_PTR gentr_rpy(const char* name, double x_mm, double y_mm, double z_mm, double roll_deg,
                    double pitch_deg, double yaw_deg);
-TRSF_PTR gentr_pao(const char* name, double px_mm, double py_mm, double pz_mm, double ax, double ay,
-                   double az, double ox, double oy, double oz);
+TRSF_PTR gentr_pao(const char* name, double px_mm, double py_mm, double pz_mm, double ax,
+                   double ay, double az, double ox, double oy, double oz);
 #define gen_tr_trsl gentr_trsl
 #define gen_tr_rot gentr_rot
 #define gen_tr_eul gentr_eul
@@ -212,58 +212,56 @@ TRSF_PTR gentr_pao(const char* name, double px_mm, double py_mm, double pz_mm, d
  * form that is a statement, `#define Rot (void) rot`. Results may alias arguments. Positions in
  * mm, angles in degrees. Rotations are exact (no renormalisation); see unit().
  */
-TRSF_PTR trmult(TRSF_PTR r, const TRSF* t1, const TRSF* t2);      /* r = t1 t2 */
-TRSF_PTR trmultinv(TRSF_PTR r, const TRSF* t1, const TRSF* t2);   /* r = t1 t2^-1 */
-TRSF_PTR invtrmult(TRSF_PTR r, const TRSF* t1, const TRSF* t2);   /* r = t1^-1 t2 */
-TRSF_PTR invert(TRSF_PTR r, const TRSF* t);                       /* r = t^-1 */
-TRSF_PTR assigntr(TRSF_PTR r, const TRSF* t);                     /* r = t (the value only) */
-TRSF_PTR ident(TRSF_PTR r);                                       /* r = I */
-TRSF_PTR rot(TRSF_PTR r, VECT axis, double angle_deg);            /* r = Rot(axis, angle) */
+TRSF_PTR trmult(TRSF_PTR r, const TRSF* t1, const TRSF* t2);    /* r = t1 t2 */
+TRSF_PTR trmultinv(TRSF_PTR r, const TRSF* t1, const TRSF* t2); /* r = t1 t2^-1 */
+TRSF_PTR invtrmult(TRSF_PTR r, const TRSF* t1, const TRSF* t2); /* r = t1^-1 t2 */
+TRSF_PTR invert(TRSF_PTR r, const TRSF* t);                     /* r = t^-1 */
+TRSF_PTR assigntr(TRSF_PTR r, const TRSF* t);                   /* r = t (the value only) */
+TRSF_PTR ident(TRSF_PTR r);                                     /* r = I */
+TRSF_PTR rot(TRSF_PTR r, VECT axis, double angle_deg);          /* r = Rot(axis, angle) */
 TRSF_PTR trsl(TRSF_PTR r, double x_mm, double y_mm, double z_mm); /* r = Trans(x, y, z) */
-TRSF_PTR eul(TRSF_PTR r, double phi_deg, double theta_deg, double psi_deg);  /* r = Euler zyz */
+TRSF_PTR eul(TRSF_PTR r, double phi_deg, double theta_deg, double psi_deg); /* r = Euler zyz */
 TRSF_PTR rpy(TRSF_PTR r, double roll_deg, double pitch_deg, double yaw_deg); /* r = RPY */
-TRSF_PTR rotr(TRSF_PTR r, VECT axis,
-              double angle_deg); /* r = r Rot(axis, angle): turn in r's frame */
-TRSF_PTR trslr(TRSF_PTR r, double x_mm, double y_mm,
-               double z_mm);                  /* r = r Trans: move in r's frame */
+TRSF_PTR rotr(TRSF_PTR r, VECT axis, double angle_deg); /* r = r Rot(axis, angle): turn in r's frame */
+TRSF_PTR trslr(TRSF_PTR r, double x_mm, double y_mm, double z_mm); /* r = r Trans: move in r's frame */
 TRSF_PTR takerot(TRSF_PTR r, const TRSF* t);  /* r's rotation = t's (r.p kept) */
 TRSF_PTR taketrsl(TRSF_PTR r, const TRSF* t); /* r.p = t.p (r's rotation kept) */
 /* The Euler (zyz) and roll-pitch-yaw angles of t (deg), through pointers; returns t. */
 const TRSF* trtoeul(const TRSF* t, double* phi_deg, double* theta_deg, double* psi_deg);
 const TRSF* trtorpy(const TRSF* t, double* roll_deg, double* pitch_deg, double* yaw_deg);
-#define Trmult (void)trmult
-#define Trmultinv (void)trmultinv
-#define Invtrmult (void)invtrmult
-#define Invert (void)invert
-#define Assigntr (void)assigntr
-#define Ident (void)ident
-#define Rot (void)rot
-#define Trsl (void)trsl
-#define Eul (void)eul
-#define Rpy (void)rpy
-#define Rotr (void)rotr
-#define Trslr (void)trslr
-#define Takerot (void)takerot
-#define Taketrsl (void)taketrsl
-#define Trtoeul (void)trtoeul
-#define Trtorpy (void)trtorpy
+#define Trmult (void) trmult
+#define Trmultinv (void) trmultinv
+#define Invtrmult (void) invtrmult
+#define Invert (void) invert
+#define Assigntr (void) assigntr
+#define Ident (void) ident
+#define Rot (void) rot
+#define Trsl (void) trsl
+#define Eul (void) eul
+#define Rpy (void) rpy
+#define Rotr (void) rotr
+#define Trslr (void) trslr
+#define Takerot (void) takerot
+#define Taketrsl (void) taketrsl
+#define Trtoeul (void) trtoeul
+#define Trtorpy (void) trtorpy
 
-VECT_PTR vecmult(VECT_PTR r, const TRSF* t, const VECT* v); /* r = t v (a point: R v + p) */
-VECT_PTR rotvec(VECT_PTR r, const TRSF* t, const VECT* v);  /* r = R v (a direction) */
-VECT_PTR vecadd(VECT_PTR r, const VECT* u, const VECT* v);  /* r = u + v */
-VECT_PTR vecsub(VECT_PTR r, const VECT* u, const VECT* v);  /* r = u - v */
-VECT_PTR vecscale(VECT_PTR r, const VECT* v, double s);     /* r = s v */
-VECT_PTR cross(VECT_PTR r, const VECT* u, const VECT* v);   /* r = u x v */
-VECT_PTR unit(VECT_PTR r, const VECT* v);                   /* r = v / |v| (zero stays zero) */
-double dot(const VECT* u, const VECT* v);                   /* u . v */
-double norm(const VECT* v);                                 /* |v| */
-#define Vecmult (void)vecmult
-#define Rotvec (void)rotvec
-#define Vecadd (void)vecadd
-#define Vecsub (void)vecsub
-#define Vecscale (void)vecscale
-#define Cross (void)cross
-#define Unit (void)unit
+VECT_PTR vecmult(VECT_PTR r, const TRSF* t, const VECT* v);   /* r = t v (a point: R v + p) */
+VECT_PTR rotvec(VECT_PTR r, const TRSF* t, const VECT* v);    /* r = R v (a direction) */
+VECT_PTR vecadd(VECT_PTR r, const VECT* u, const VECT* v);    /* r = u + v */
+VECT_PTR vecsub(VECT_PTR r, const VECT* u, const VECT* v);    /* r = u - v */
+VECT_PTR vecscale(VECT_PTR r, const VECT* v, double s);       /* r = s v */
+VECT_PTR cross(VECT_PTR r, const VECT* u, const VECT* v);     /* r = u x v */
+VECT_PTR unit(VECT_PTR r, const VECT* v);                     /* r = v / |v| (zero stays zero) */
+double dot(const VECT* u, const VECT* v);                     /* u . v */
+double norm(const VECT* v);                                   /* |v| */
+#define Vecmult (void) vecmult
+#define Rotvec (void) rotvec
+#define Vecadd (void) vecadd
+#define Vecsub (void) vecsub
+#define Vecscale (void) vecscale
+#define Cross (void) cross
+#define Unit (void) unit
 
 /*
  * Printing, on `fp` (stdout, stderr, a file): printr the name and the 3 x 4 matrix (rows of
@@ -273,8 +271,8 @@ double norm(const VECT* v);                                 /* |v| */
 const TRSF* printr(const TRSF* t, FILE* fp);
 const VECT* printv(const VECT* v, FILE* fp);
 #define printtr printr
-#define Printr (void)printr
-#define Printv (void)printv
+#define Printr (void) printr
+#define Printv (void) printv
 
 /* --- Positions ---------------------------------------------------------------------------- */
 
