@@ -12,6 +12,11 @@
 //   s.arm_session.reset();                  // rccl_close: all of it goes, in one step
 //   s.cell_session.emplace(std::move(cell));  // rccl_cell_open; MANIP handles, mnp_*
 //
+// A cell is a cell::Workcell and its robots rccl::Arm: cell::Cell and rccl::Manipulator in this
+// process, or net::RemoteCell and net::RemoteArm for robots `rccx serve` processes run
+// (RCCX_CELL_REMOTE=1, rccl_cell_open_remote). The mnp_ calls go through those interfaces; the
+// few that need one kind (a session's clock, a joint start) use `local` / `remote`.
+//
 // At most one of them is open (and neither while the RTC level's session is, rtc_compat.cpp).
 // The sample loop reads the open one (t6 for a C functional transform, nextmove) only while
 // control runs: the session is emplaced before control starts and reset after it stopped.
@@ -40,8 +45,10 @@
 #include <vector>
 
 #include "rccx/cell/cell.hpp"
+#include "rccx/cell/workcell.hpp"
 #include "rccx/kinematics/robot_model.hpp"
 #include "rccx/math/transform.hpp"
+#include "rccx/rccl/arm.hpp"
 #include "rccx/rccl/manipulator.hpp"
 #include "rccx/rccl/position.hpp"
 #include "rccx/rccl/transforms.hpp"
@@ -57,13 +64,19 @@
 namespace rccx::compat {
 struct PositionBox;
 }
+namespace rccx::net {
+class RemoteCell;
+class RemoteArm;
+}  // namespace rccx::net
 
 /// What a MANIP points to: a robot of the open cell and its own settings.
 struct rccl_manip {
   std::string name;
-  rccx::rccl::Manipulator* arm = nullptr;
-  rccx::rccl::MotionSettings settings;  ///< mnp_setvel, mnp_setmod, mnp_settime
-  rccx::rccl::StartWhen next;           ///< mnp_after / rccl_together, for the next mnp_move
+  rccx::rccl::Arm* arm = nullptr;            ///< local or remote, below
+  rccx::rccl::Manipulator* local = nullptr;  ///< a robot of this process (cell::Cell)
+  rccx::net::RemoteArm* remote = nullptr;    ///< a robot of a serve process (net::RemoteCell)
+  rccx::rccl::MotionSettings settings;       ///< mnp_setvel, mnp_setmod, mnp_settime
+  rccx::rccl::StartWhen next;                ///< mnp_after / rccl_together, for the next mnp_move
   POS* park = nullptr;
   TRSF_PTR tool = nullptr, base_inv = nullptr, tool_frame = nullptr;
   std::size_t failures_seen = 0;
@@ -71,6 +84,9 @@ struct rccl_manip {
   std::map<std::uint64_t, std::string> motion_names;
   /// motion id -> its position, whose POS.code the motion's end sets (as for one robot)
   std::map<std::uint64_t, rccx::compat::PositionBox*> motion_boxes;
+  /// remote: motion id -> its target, until its end, failure or cancellation arrives. A local
+  /// generator counts Position::pending_ends itself (POS.end); for a remote one this does.
+  std::map<std::uint64_t, rccx::rccl::PositionPtr> in_flight;
 };
 
 namespace rccx::compat {
@@ -139,12 +155,16 @@ struct ArmSession {
 
 /// What an open cell (rccl_cell_open .. rcclRelease) needs: the cell, its robots' MANIP handles.
 struct CellSession {
-  explicit CellSession(std::unique_ptr<rccx::cell::Cell> loaded) : cell(std::move(loaded)) {}
+  explicit CellSession(std::unique_ptr<rccx::cell::Cell> loaded);
+  explicit CellSession(std::unique_ptr<rccx::net::RemoteCell> joined);
   std::map<std::string, std::unique_ptr<rccl_manip>, std::less<>> manips;
-  /// After the handles, which point into it: it stops its robots before they go.
-  std::unique_ptr<rccx::cell::Cell> cell;
-  bool started = false;  ///< rcclStart() was called
-  Refusals refusals;     ///< mnp_move() calls that failed
+  /// After the handles, which point into it: it stops its robots before they go (a remote
+  /// cell leaves the domain: the serve processes then stop the robots it had attached).
+  std::unique_ptr<rccx::cell::Workcell> cell;
+  rccx::cell::Cell* local = nullptr;        ///< *cell, when it runs in this process
+  rccx::net::RemoteCell* remote = nullptr;  ///< *cell, when serve processes run it
+  bool started = false;                     ///< rcclStart() was called
+  Refusals refusals;                        ///< mnp_move() calls that failed
 };
 
 /// Everything the C calls share: the program-wide part, then the one open session. Members are
@@ -265,12 +285,16 @@ void for_each_word(const std::string& text, F&& take) {
 }
 /// POS.code of each motion's position from the arm's events since the last call: 0 ended,
 /// RCCL_NEXTMOVE / RCCL_ONF ended early by nextmove, RTC_E_MOTION failed or cancelled.
-void show_motion_codes(rc::Manipulator& arm,
-                       const std::map<std::uint64_t, PositionBox*>& motion_boxes);
+/// Returns the events it took.
+std::vector<rc::MotionEvent> show_motion_codes(
+    rc::Arm& arm, const std::map<std::uint64_t, PositionBox*>& motion_boxes);
 /// The robot for rccl_open / RCCX_ROBOT.
 kin::RobotModel choose_robot(const char* robot);
 /// waitfor() with a cell: one tick of the cell's clock.
 int cell_wait_tick();
+/// True once `e` of robot `m` has happened, or (a motion's end) it failed or was cancelled:
+/// mnp_ended, mnp_completed and `completed` alike in one process and across processes.
+bool cell_event_done(rccl_manip& m, const rc::Event& e);
 /// How a control session ended, for messages.
 std::string describe_end(const rtc::Termination& t);
 /// Applies the planning side of `nextmove` (a program that set it between samples).

@@ -555,6 +555,22 @@ typedef struct rccl_manip MANIP;
  */
 int rccl_cell_open(const char* cell_file);
 
+/*
+ * Across processes (docs/NETWORK.md, "The C interface across processes"): the same calls drive
+ * the robots that `rccx serve` processes run, in real time, when the environment has
+ * RCCX_CELL_REMOTE=1 (rccl_cell_open then joins them: a program does not change) or the program
+ * calls rccl_cell_open_remote. The DDS domain is `domain` (-1: $RCCX_DOMAIN, else 0), the
+ * network interface $RCCX_DDS_INTERFACE ("lo" on one machine), the time after which a silent
+ * serve process counts as lost $RCCX_DETECTION_MS (default 20). Every robot of the cell file
+ * must be served (RTC_E_OPEN after 10 s otherwise, naming the robot and the serve command).
+ * What cannot cross processes is refused with its reason: rccl_together (RTC_E_NOT_YET), a
+ * position with a C function's transform (RTC_E_UNREACHABLE at mnp_move). mnp_tool_frame's
+ * transform is sent by name ("frame:<robot>"); its TRSF's values stay those of the identity
+ * in the program. waitfor() waits about 1 ms a tick; rtime and rccl_sample are the first
+ * robot's (by name) serve process's.
+ */
+int rccl_cell_open_remote(const char* cell_file, int domain);
+
 /**
  * The robot `name` of the open cell (Multi-RCCL's rcclCreate; `flags` reserved, pass 0). The
  * same handle for the same name. NULL on error (RTC_E_SEQUENCE without a cell, RTC_E_ROBOT

@@ -13,6 +13,8 @@
 #include <utility>
 #include <vector>
 
+#include "rccx/net/remote_cell.hpp"
+// rccx's headers before the C ones (compat_internal.hpp)
 #include "compat_internal.hpp"
 #include "compat_shared.hpp"
 
@@ -127,10 +129,21 @@ void note_refusal(int code) noexcept {
 }
 
 /// The result of a C transform's function, the planning side: `nextmove` set by the program.
-void act_on_nextmove(State& s) noexcept {
+/// `in_loop`: called from the sample loop, where a remote arm's request (a round trip) must
+/// not be made; a remote cell has no local loop that runs C functions, so none is lost.
+void act_on_nextmove(State& s, bool in_loop) noexcept {
   if (s.arm_session) s.arm_session->arm.generator().request_next();
   if (s.cell_session) {
-    for (const auto& [name, m] : s.cell_session->manips) m->arm->generator().request_next();
+    for (const auto& [name, m] : s.cell_session->manips) {
+      if (m->local != nullptr) {
+        m->local->generator().request_next();
+      } else if (m->remote != nullptr && !in_loop) {
+        (void)guarded("nextmove", Say::print, RTC_E_MOTION, [&] {
+          m->remote->nextmove();
+          return RTC_OK;
+        });
+      }
+    }
   }
 }
 
@@ -239,7 +252,7 @@ void take_nextmove() noexcept {
   State& s = state();
   if (nextmove != 0) {
     nextmove = 0;
-    act_on_nextmove(s);
+    act_on_nextmove(s, false);
   }
 }
 
@@ -247,7 +260,7 @@ void loop_nextmove() noexcept {
   if (nextmove == 0) return;
   nextmove = 0;
   // The loop is the generator's own thread: request_next() takes effect at the next step.
-  act_on_nextmove(state());
+  act_on_nextmove(state(), true);
 }
 
 }  // namespace rccx::compat

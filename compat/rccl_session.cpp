@@ -174,7 +174,7 @@ void refresh() noexcept {
   } else if (s.cell_session) {
     completed = 1;
     for (const auto& [name, m] : s.cell_session->manips) {
-      if (!m->arm->happened(rc::Manipulator::completed())) completed = 0;
+      if (!cell_event_done(*m, rc::Arm::completed())) completed = 0;
     }
   } else {
     completed = 1;
@@ -235,21 +235,25 @@ bool rccl_session_open() noexcept {
   return s.arm_session || s.cell_session;
 }
 
-void show_motion_codes(rc::Manipulator& arm,
-                       const std::map<std::uint64_t, PositionBox*>& motion_boxes) {
-  for (const rc::MotionEvent& e : arm.take_events()) {
+std::vector<rc::MotionEvent> show_motion_codes(
+    rc::Arm& arm, const std::map<std::uint64_t, PositionBox*>& motion_boxes) {
+  std::vector<rc::MotionEvent> events = arm.take_events();
+  // Contacts are known where the generator runs: a remote arm's nextmove is RCCL_NEXTMOVE.
+  const auto* local = dynamic_cast<const rc::Manipulator*>(&arm);
+  for (const rc::MotionEvent& e : events) {
     const auto it = motion_boxes.find(e.id);
     if (it == motion_boxes.end()) continue;
     if (e.kind == rc::EventKind::ended) {
       int code = 0;
       if (e.message() == rc::kNextmoveText) {
-        code = arm.contact(rc::Motion{e.id}) ? RCCL_ONF : RCCL_NEXTMOVE;
+        code = local != nullptr && local->contact(rc::Motion{e.id}) ? RCCL_ONF : RCCL_NEXTMOVE;
       }
       it->second->shown->code = code;
     } else if (e.kind == rc::EventKind::failed || e.kind == rc::EventKind::cancelled) {
       it->second->shown->code = RTC_E_MOTION;
     }
   }
+  return events;
 }
 
 void report_failures(ArmSession& a) {

@@ -212,6 +212,8 @@ TRSF_PTR keep_transform(const rc::TransformPtr& source) {
     if (in_loop) to_c(v, b->c);
     return v;
   });
+  // A robot's tool frame ("frame:puma") stays one a serve process can resolve (net::codec).
+  box->live->set_reference(source->reference());
   to_c(math::Transform::identity(), box->c);
   return register_box(std::move(box));
 }
