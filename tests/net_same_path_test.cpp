@@ -151,15 +151,16 @@ std::vector<ProgramMotion> program(cell::Workcell& c) {
   wait_end(c, microbo, m3, "FOLLOW");
 
   // 4. The Microbo back out of the PUMA's way to a fixed goal (its rest no longer tracks the
-  // PUMA), then the PUMA back to P1's joints once the Microbo is there.
+  // PUMA), then the PUMA away from it once the Microbo is there (a serve's collision check
+  // grows the other robot's margin with its state's age: a stalled machine stops robots that
+  // pass close).
   const rccl::Motion m4 = microbo.move(c.world_goal("microbo", "BACK", tool_down(0.19, 0.0, 0.19)));
-  puma.set_mode(rccl::Mode::joint);
-  puma.set_velocity(0.05, 0.5);
-  const rccl::Motion p4 = puma.move(rccl::Position::joints("P1", qp), c.after("microbo", m4.end()));
+  const rccl::Motion p4 = puma.move(c.world_goal("puma", "AWAY", tool_down(-0.12, -0.07, 0.24)),
+                                    c.after("microbo", m4.end()));
   done.push_back({"microbo", m4.id, "BACK (Cartesian)"});
-  done.push_back({"puma", p4.id, "P1 again (joint, after BACK's end)"});
+  done.push_back({"puma", p4.id, "AWAY (Cartesian, after BACK's end)"});
   wait_end(c, microbo, m4, "BACK");
-  wait_end(c, puma, p4, "P1 again");
+  wait_end(c, puma, p4, "AWAY");
   // Every motion ended as planned: none failed or was cancelled (a collision stop, a lost
   // robot) on the way.
   std::string failed;
