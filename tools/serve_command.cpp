@@ -27,6 +27,7 @@ struct ServeArgs {
   Duration claim_wait{"300ms"};
   std::string secure;
   std::string identity;
+  bool no_ros2 = false;
 };
 
 int run_serve(const ServeArgs& args) {
@@ -58,6 +59,7 @@ int run_serve(const ServeArgs& args) {
   o.net.secure_dir = args.secure;
   o.net.secure_identity = args.identity;
   o.claim_wait = args.claim_wait.value;
+  o.ros2_joint_states = !args.no_ros2;
   std::unique_ptr<net::RobotServer> server;
   try {
     server = std::make_unique<net::RobotServer>(model, args.robots, o);
@@ -125,6 +127,9 @@ void add_serve_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--identity", args->identity,
                   "This process's participant name in --secure's directory")
       ->check(not_empty());
+  cmd->add_flag("--no-ros2", args->no_ros2,
+                "Do not publish each robot's joint state for ROS 2 (rt/<robot>/joint_states, "
+                "sensor_msgs/JointState); published by default");
   cmd->callback([args, &exit_code] { guarded(exit_code, [&] { return run_serve(*args); }); });
 }
 

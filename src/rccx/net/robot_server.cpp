@@ -9,10 +9,12 @@
 #include <deque>
 #include <random>
 #include <set>
+#include <span>
 #include <stdexcept>
 
 #include "rccx/io/console.hpp"
 #include "rccx/net/codec.hpp"
+#include "rccx/net/ros2_joint_state.hpp"
 #include "rccx/rtc/latest.hpp"
 
 namespace rccx::net {
@@ -97,6 +99,8 @@ struct RobotServer::Local {
   std::uint64_t halt_upto = 0;
   std::set<std::string> follows;  ///< remote robots whose frame the last motion uses
   std::set<std::string> streams;  ///< streams the last motion uses
+  /// Its ROS 2 joint state (ServeOptions::ros2_joint_states; null when off).
+  std::unique_ptr<JointStatePublisher> ros2;
 };
 
 struct RobotServer::Dedup {
@@ -170,12 +174,19 @@ std::string RobotServer::banner() const {
     const char* env = std::getenv("RCCX_DDS_INTERFACE");
     interface = env != nullptr && *env != '\0' ? env : "Cyclone's default";
   }
+  std::string ros2 = "no ROS 2 joint states (--no-ros2)";
+  if (options_.ros2_joint_states) {
+    std::vector<std::string> topics;
+    for (const auto& r : robot_names_) topics.push_back(ros2_joint_states_topic(r));
+    ros2 = "ROS 2 joint states on " + join(topics);
+  }
   return fmt::format(
-      "rccx serve: {} of cell {} as {}, DDS domain {}, interface {}, {}", join(robot_names_),
+      "rccx serve: {} of cell {} as {}, DDS domain {}, interface {}, {}; {}", join(robot_names_),
       full_model_.name, participant_name_, domain_of(options_.net), interface,
       secure ? fmt::format("secure (DDS Security, identity {})", options_.net.secure_identity)
              : "plain DDS: anyone on the network can read and command these robots; use "
-               "--secure DIR for DDS Security");
+               "--secure DIR for DDS Security",
+      ros2);
 }
 
 std::string RobotServer::failure() const {
@@ -296,6 +307,10 @@ void RobotServer::start() {
       l->gen = &l->arm->generator();
       l->session = &cell_->session(name);
       l->period_s = std::chrono::duration<double>(l->session->period()).count();
+      if (options_.ros2_joint_states) {
+        l->ros2 = std::make_unique<JointStatePublisher>(*participant_, name,
+                                                        full_model_.find_robot(name)->model);
+      }
       locals_.push_back(std::move(l));
     }
     for (const auto& r : full_model_.robots) {
@@ -752,6 +767,15 @@ void RobotServer::publish_states(std::int64_t now, bool last) {
     copy_to(s.program, l.program);
     check(dds_write(state_writer_.get(), &s), "a robot state");
     l.written_ns = now;
+    // ROS 2's view of each new state (not the heartbeat's repeats): the measured joints (ROS's
+    // convention for joint_states), the commanded speeds, stamped when they were read (the
+    // state's written_ns; its stamp_ns is the commanded setpoint's time, two periods ahead).
+    if (const std::size_t n = l.ros2 ? l.ros2->dof() : 0;
+        n != 0 && (fresh || last) && h.dof >= n && n <= std::size(s.q_measured)) {
+      l.ros2->publish(
+          s.written_ns, std::span<const double>(s.q_measured, n),
+          s.dof == n ? std::span<const double>(s.qd_commanded, n) : std::span<const double>{});
+    }
   }
 }
 

@@ -11,9 +11,9 @@
 //
 // Threads: the cell's control task (never calls DDS: after each tick its cycle observer copies
 // each robot's setpoint into a triple buffer) and one middleware thread that polls every 1 ms:
-// it writes states and heartbeats, takes requests (all Manipulator calls are made from it),
-// answers them, publishes the motions' events, and stops the robots of a lost program or of a
-// lost leader smoothly (Manipulator::halt) saying why.
+// it writes states (and each robot's ROS 2 joint state) and heartbeats, takes requests (all
+// Manipulator calls are made from it), answers them, publishes the motions' events, and stops the
+// robots of a lost program or of a lost leader smoothly (Manipulator::halt) saying why.
 #pragma once
 
 #include <atomic>
@@ -47,6 +47,9 @@ struct ServeOptions {
   std::chrono::nanoseconds claim_wait = std::chrono::milliseconds(300);
   /// SCHED_FIFO and mlockall for the control task when allowed.
   bool real_time_scheduling = true;
+  /// Each served robot's joint state also as ROS 2's sensor_msgs/JointState on
+  /// "rt/<robot>/joint_states" (net::JointStatePublisher; `rccx serve --no-ros2` turns it off).
+  bool ros2_joint_states = true;
 };
 
 /// The part of `model` a serve process of `robots` runs: those robots only, its objects and
@@ -75,7 +78,7 @@ class RobotServer {
   /// claims back and ends control. Idempotent.
   void stop();
 
-  /// One line: what it serves, the domain, interface, plain or secure.
+  /// One line: what it serves, the domain, interface, plain or secure, ROS 2 joint states.
   [[nodiscard]] std::string banner() const;
   [[nodiscard]] const std::string& participant() const noexcept { return participant_name_; }
   /// Set when the middleware thread stopped on an error (what went wrong); "" while all is well.
