@@ -1,0 +1,379 @@
+// The cell across hosts (issue 29, "Hosts"; docs/NETWORK.md, "Across hosts: delay, loss and a
+// cut link"): the PUMA's `rccx serve` in host a, the Microbo's in host b and the program in
+// host c, three network namespaces on one segment through the test's relay (2 ms each way, 1 %
+// of frames lost each way; tests/net/netns_fixture.hpp). With that link the program's motions
+// all reach their ends and the Microbo tracks the PUMA's tool within a bound; with the link cut,
+// each serve stops its robot smoothly within the detection time and says why, and the program
+// sees its motions fail with the reason. Root only: skipped, saying why, elsewhere.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <optional>
+#include <regex>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "netns_fixture.hpp"
+#include "rccx/cell/cell_model.hpp"
+#include "rccx/kinematics/kinematics.hpp"
+#include "rccx/net/dds.hpp"
+#include "rccx/rccl/trajectory.hpp"
+
+using namespace rccx;
+using namespace std::chrono_literals;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+const std::string kCell = std::string(RCCX_CELLS_DIR) + "/cvarl.json";
+
+/// The serves' and the program's detection time. Heartbeats go every detection / 4 = 25 ms, so
+/// a peer counts as lost only when 4 in a row are lost or late: at 1 % loss, 1e-8 a window. Each
+/// crossing adds 2 ms (4 ms a round trip) and the relay's and this loaded 2-core machine's
+/// scheduling add tens of ms now and then; the 20 ms default would stop the robots for a stall
+/// of the test machine rather than of the link. 100 ms is UR's RTDE watchdog at its lowest rate.
+constexpr int kDetectionMs = 100;
+/// The PUMA's period in cvarl.json (7 ms) and the Microbo's (4 x 7 ms), s.
+constexpr double kPumaPeriodS = 0.007, kMicroboPeriodS = 0.028;
+/// What a loaded machine may add to any of the times measured here (scheduling of five
+/// processes and the relay on 2 cores shared with other builds): one more detection time.
+constexpr double kSlackMs = kDetectionMs;
+
+#define NETNS_OR_SKIP()                                                      \
+  do {                                                                       \
+    if (const std::string why = netns::Hosts::unavailable(); !why.empty()) { \
+      GTEST_SKIP() << why;                                                   \
+    }                                                                        \
+  } while (false)
+
+/// A domain of this test process's own (the namespaces are private, this only keeps runs of the
+/// test that overlap apart).
+std::string domain() {
+  return std::to_string(100 + getpid() % 100);
+}
+
+std::int64_t steady_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now().time_since_epoch())
+      .count();
+}
+
+bool contains(const std::string& s, const std::string& part) {
+  return s.find(part) != std::string::npos;
+}
+
+/// `rccx serve` of `robots` in host `host`, on the host's interface.
+netns::Child serve(netns::Hosts& hosts, int host, const std::string& robots, const std::string& d) {
+  return hosts.spawn(
+      host, {RCCX_EXE, "serve", "--cell", kCell, "--robots", robots, "--domain", d, "--interface",
+             netns::Hosts::kInterface, "--detection", std::to_string(kDetectionMs) + "ms",
+             "--claim-wait", "1s", "--seconds", "170"});
+}
+
+/// Waits for both serves to serve; the message says what they printed when one did not.
+::testing::AssertionResult serving(const netns::Child& a, const netns::Child& b) {
+  for (const netns::Child* c : {&a, &b}) {
+    if (!c->wait_for_output("rccx serve: serving", 30s)) {
+      return ::testing::AssertionFailure() << "a serve did not start in 30 s:\nhost a:\n"
+                                           << a.output() << "\nhost b:\n"
+                                           << b.output();
+    }
+  }
+  return ::testing::AssertionSuccess();
+}
+
+std::string read_file(const std::string& path) {
+  std::ifstream f(path);
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+/// One RobotState as a recorder in the serve's own host received it.
+struct Sample {
+  std::uint64_t sample = 0;
+  std::int64_t stamp_ns = 0;     ///< CLOCK_REALTIME the setpoint is for
+  std::int64_t received_ns = 0;  ///< steady clock
+  double period_s = 0;
+  std::vector<double> q;
+};
+
+std::vector<Sample> samples_of(const std::string& file, const std::string& robot) {
+  std::vector<Sample> v;
+  std::istringstream in(read_file(file));
+  std::string line;
+  while (std::getline(in, line)) {
+    std::istringstream l(line);
+    std::string name;
+    Sample s;
+    unsigned status = 0;
+    l >> name >> s.sample >> s.stamp_ns >> s.received_ns >> s.period_s >> status;
+    if (!l || name != robot) continue;
+    double q = 0;
+    while (l >> q) s.q.push_back(q);
+    if (v.empty() || s.sample > v.back().sample) v.push_back(std::move(s));
+  }
+  return v;
+}
+
+/// The generator's acceleration bounds for a robot of the cell (rad/s^2), as its serve has them.
+kin::JointVector acceleration_bounds(const std::string& robot) {
+  const cell::CellModel m = cell::load_cell_file(kCell);
+  const cell::CellRobot* r = m.find_robot(robot);
+  const auto k = kin::make_kinematics(r->model);
+  rccl::GeneratorOptions o;
+  o.period_s =
+      std::chrono::duration<double>(m.period(static_cast<std::size_t>(r - m.robots.data())))
+          .count();
+  const rccl::TrajectoryGenerator g(*k, o);
+  return g.options().max_acceleration;
+}
+
+/// The largest |second difference| / P^2 over the bound, any joint, over consecutive samples
+/// from index `from` on: 1 means at the bound.
+double worst_acceleration_ratio(const std::vector<Sample>& v, std::size_t from,
+                                const kin::JointVector& bound) {
+  double worst = 0.0;
+  for (std::size_t i = std::max<std::size_t>(from, 2); i < v.size(); ++i) {
+    if (v[i].sample != v[i - 1].sample + 1 || v[i - 1].sample != v[i - 2].sample + 1) continue;
+    const double P = v[i].period_s;
+    for (std::size_t j = 0; j < v[i].q.size(); ++j) {
+      const double a = (v[i].q[j] - 2 * v[i - 1].q[j] + v[i - 2].q[j]) / (P * P);
+      worst = std::max(worst, std::abs(a) / bound[j]);
+    }
+  }
+  return worst;
+}
+
+double step(const std::vector<Sample>& v, std::size_t i) {
+  double s = 0;
+  for (std::size_t j = 0; j < v[i].q.size(); ++j) s += std::pow(v[i].q[j] - v[i - 1].q[j], 2);
+  return std::sqrt(s);
+}
+
+/// How a serve stopped its robot after the cut, from the samples recorded in its host.
+struct Stop {
+  double slowing_ms = -1;  ///< cut -> the first setpoint slower than before the cut (stamp)
+  double rest_ms = -1;     ///< cut -> the first setpoint equal to the one before
+  double accel_ratio = 0;  ///< worst |acceleration| / the generator's bound around the stop
+  std::size_t samples = 0;
+};
+
+Stop stop_of(const std::vector<Sample>& v, std::int64_t cut_wall_ns, const std::string& robot) {
+  Stop s;
+  s.samples = v.size();
+  std::size_t cut = 0;
+  while (cut < v.size() && v[cut].stamp_ns < cut_wall_ns) ++cut;
+  if (cut < 12 || cut + 2 >= v.size()) return s;
+  // The joint step per sample while cruising: the median of the 10 before the cut.
+  std::vector<double> before;
+  for (std::size_t i = cut - 10; i < cut; ++i) before.push_back(step(v, i));
+  std::sort(before.begin(), before.end());
+  const double cruise = before[before.size() / 2];
+  for (std::size_t i = cut; i < v.size(); ++i) {
+    const double d = step(v, i);
+    const double at_ms = static_cast<double>(v[i].stamp_ns - cut_wall_ns) * 1e-6;
+    if (s.slowing_ms < 0 && d < 0.8 * cruise) s.slowing_ms = at_ms;
+    if (d < 1e-12) {
+      s.rest_ms = at_ms;
+      break;
+    }
+  }
+  s.accel_ratio = worst_acceleration_ratio(v, cut - 3, acceleration_bounds(robot));
+  return s;
+}
+
+double number_after(const std::string& text, const std::string& pattern) {
+  std::smatch m;
+  if (!std::regex_search(text, m, std::regex(pattern))) return -1;
+  return std::stod(m[1].str());
+}
+
+}  // namespace
+
+TEST(NetHosts, ThroughDelayAndLossEveryMotionEndsAndTheMicroboTracksThePumasTool) {
+  NETNS_OR_SKIP();
+  netns::Hosts hosts({.hosts = 3, .delay_ms = 2.0, .loss = 0.01, .seed = 29});
+  const std::string d = domain();
+  netns::Child puma = serve(hosts, 0, "puma", d);
+  netns::Child microbo = serve(hosts, 1, "microbo", d);
+  ASSERT_TRUE(serving(puma, microbo));
+  const netns::RelayStats before = hosts.relay_stats();
+  netns::Child program = hosts.spawn(2, {RCCX_HOSTS_PROGRAM, "track", kCell, d,
+                                         std::to_string(kDetectionMs), netns::Hosts::kInterface});
+  const std::optional<int> code = program.wait(150s);
+  const netns::RelayStats after = hosts.relay_stats();
+  const std::string out = program.output();
+  std::printf("[ program  ]\n%s", out.c_str());
+  if (after.valid) {
+    std::printf(
+        "[ figures  ] relay: %llu frames forwarded, %llu lost (%.2f %%), held p50 %.3f p99 %.3f "
+        "max %.3f ms\n",
+        static_cast<unsigned long long>(after.forwarded - before.forwarded),
+        static_cast<unsigned long long>(after.lost - before.lost),
+        100.0 * static_cast<double>(after.lost - before.lost) /
+            static_cast<double>(std::max<std::uint64_t>(
+                1, after.forwarded - before.forwarded + after.lost - before.lost)),
+        after.delay_p50_ms, after.delay_p99_ms, after.delay_max_ms);
+    // The link did lose frames during the program: the test is of a lossy link.
+    EXPECT_GT(after.lost, before.lost);
+  }
+  ASSERT_TRUE(code.has_value()) << "the program did not end in 150 s:\n"
+                                << out << "\nhost a:\n"
+                                << puma.output() << "\nhost b:\n"
+                                << microbo.output();
+  EXPECT_EQ(*code, 0) << "a motion did not reach its end:\n"
+                      << out << "\nhost a:\n"
+                      << puma.output() << "\nhost b:\n"
+                      << microbo.output();
+  const double reached = number_after(out, R"(reached (\d+) of)");
+  const double total = number_after(out, R"(of (\d+) motions)");
+  EXPECT_GE(total, 7.0) << out;
+  EXPECT_EQ(reached, total) << out;
+  // The Microbo's commanded tool against the PUMA's + 150 mm x at the same stamp. At 20 mm/s
+  // the Microbo's serve extrapolates the PUMA's newest state over its age (2 ms in transit, up to
+  // a 7 ms period, more when a state was lost): a velocity error during the PUMA's speed-up and
+  // slow-down of 20 mm/s x ~10 ms = 0.2 mm, and the Microbo's own generator following a moving
+  // goal at its 28 ms period (net_serve_test's loopback figure: under 5 mm). 5 mm holds both
+  // with the margin the one-process follow test has; the measured worst is printed.
+  const double worst_mm = number_after(out, R"(tracking: worst ([0-9.]+) mm)");
+  const double count = number_after(out, R"(over (\d+) samples)");
+  std::printf(
+      "[ figures  ] tracking across hosts (2 ms, 1 %% loss): worst %.3f mm over %.0f "
+      "Microbo samples\n",
+      worst_mm, count);
+  EXPECT_GE(count, 50.0) << "too few samples matched: " << out;
+  EXPECT_GE(worst_mm, 0.0) << out;
+  EXPECT_LT(worst_mm, 5.0) << out;
+  // Neither serve stopped a robot for a lost peer on the way.
+  EXPECT_FALSE(contains(puma.output(), "was lost (no heartbeat")) << puma.output();
+  const std::string mo = microbo.output();
+  EXPECT_FALSE(contains(mo.substr(0, mo.find("was lost (no heartbeat")), "is silent for")) << mo;
+  program.stop();
+  puma.stop();
+  microbo.stop();
+}
+
+TEST(NetHosts, WithTheLinkCutEachServeStopsItsRobotWithinTheDetectionTimeAndSaysWhy) {
+  NETNS_OR_SKIP();
+  netns::Hosts hosts({.hosts = 3, .delay_ms = 2.0, .loss = 0.01, .seed = 31});
+  const std::string d = domain();
+  netns::Child puma = serve(hosts, 0, "puma", d);
+  netns::Child microbo = serve(hosts, 1, "microbo", d);
+  ASSERT_TRUE(serving(puma, microbo));
+  // Recorders beside each serve: what it commands stays visible to them through the cut.
+  const std::string file_a = ::testing::TempDir() + "rccx_hosts_a_" + d + ".txt";
+  const std::string file_b = ::testing::TempDir() + "rccx_hosts_b_" + d + ".txt";
+  netns::Child rec_a =
+      hosts.spawn(0, {RCCX_HOSTS_PROGRAM, "record", d, std::to_string(kDetectionMs),
+                      netns::Hosts::kInterface, file_a});
+  netns::Child rec_b =
+      hosts.spawn(1, {RCCX_HOSTS_PROGRAM, "record", d, std::to_string(kDetectionMs),
+                      netns::Hosts::kInterface, file_b});
+  ASSERT_TRUE(rec_a.wait_for_output("recording", 30s)) << rec_a.output();
+  ASSERT_TRUE(rec_b.wait_for_output("recording", 30s)) << rec_b.output();
+  netns::Child program = hosts.spawn(2, {RCCX_HOSTS_PROGRAM, "long", kCell, d,
+                                         std::to_string(kDetectionMs), netns::Hosts::kInterface});
+  ASSERT_TRUE(program.wait_for_output("moving", 120s)) << "the long motions did not start:\n"
+                                                       << program.output() << "\nhost a:\n"
+                                                       << puma.output() << "\nhost b:\n"
+                                                       << microbo.output();
+  std::this_thread::sleep_for(1500ms);  // cruising at 5 mm/s, 4.5 s of the motion left
+
+  const std::int64_t cut_steady = steady_ns();
+  const std::int64_t cut_wall = net::wall_ns();
+  hosts.cut(true);
+  const double cut_took_ms = static_cast<double>(steady_ns() - cut_steady) * 1e-6;
+  // When each serve said why (its output polled every 2 ms).
+  std::map<std::string, double> said_ms;
+  const std::string why = "was lost (no heartbeat for";
+  while (steady_ns() - cut_steady < 5'000'000'000LL &&
+         (said_ms.size() < 2 || !program.wait(0ms).has_value())) {
+    for (const auto& [name, c] : {std::pair{"puma", &puma}, std::pair{"microbo", &microbo}}) {
+      if (said_ms.count(name) == 0 && contains(c->output(), why)) {
+        said_ms[name] = static_cast<double>(steady_ns() - cut_steady) * 1e-6;
+      }
+    }
+    std::this_thread::sleep_for(2ms);
+  }
+  std::this_thread::sleep_for(1500ms);  // each robot at rest, recorded
+  rec_a.stop();
+  rec_b.stop();
+  const std::optional<int> code = program.wait(10s);
+  const std::string out = program.output(), pa = puma.output(), mb = microbo.output();
+  std::printf("[ program  ]\n%s[ host a   ]\n%s[ host b   ]\n%s", out.c_str(), pa.c_str(),
+              mb.c_str());
+
+  // The program: each robot's motion failed, the robot lost, within detection + slack.
+  ASSERT_TRUE(code.has_value()) << out;
+  EXPECT_EQ(*code, 0) << "a motion did not fail:\n" << out;
+  const double bound_program_ms = kDetectionMs + kMicroboPeriodS * 1e3 + kSlackMs;
+  for (const char* robot : {"puma", "microbo"}) {
+    std::smatch m;
+    const std::string pattern = std::string("failed ") + robot + R"( (\d+) ([^\n]*))";
+    ASSERT_TRUE(std::regex_search(out, m, std::regex(pattern))) << out;
+    const double ms = static_cast<double>(std::stoll(m[1].str()) - cut_steady) * 1e-6;
+    std::printf("[ figures  ] the program saw %s's motion fail %.1f ms after the cut: %s\n", robot,
+                ms, m[2].str().c_str());
+    EXPECT_TRUE(contains(m[2].str(), std::string("robot ") + robot + " lost")) << m[2].str();
+    EXPECT_GT(ms, 0.5 * kDetectionMs) << "failed before the detection time could pass";
+    EXPECT_LE(ms, bound_program_ms);
+  }
+
+  // The serves: each said why and stopped its robot smoothly within the detection time.
+  EXPECT_TRUE(contains(pa, "rccx serve: robot puma: the program ")) << pa;
+  EXPECT_TRUE(contains(mb, "rccx serve: robot microbo: the program ")) << mb;
+  const struct {
+    const char* robot;
+    const std::string& file;
+    double period_s;
+  } robots[] = {{"puma", file_a, kPumaPeriodS}, {"microbo", file_b, kMicroboPeriodS}};
+  for (const auto& r : robots) {
+    const std::string& text = std::string(r.robot) == "puma" ? pa : mb;
+    const double serve_ms = number_after(text, R"(no heartbeat for ([0-9.]+) ms)");
+    const Stop s = stop_of(samples_of(r.file, r.robot), cut_wall, r.robot);
+    const double bound_ms = kDetectionMs + r.period_s * 1e3 + kSlackMs;
+    std::printf(
+        "[ figures  ] %s (period %.0f ms): its serve said why %.1f ms after the cut (its program "
+        "silent %.0f ms by its own clock); setpoints slower from %.1f ms, at rest at %.1f ms; "
+        "worst |accel| / bound %.3f over %zu samples (the cut took %.1f ms to apply)\n",
+        r.robot, r.period_s * 1e3, said_ms.count(r.robot) ? said_ms[r.robot] : -1.0, serve_ms,
+        s.slowing_ms, s.rest_ms, s.accel_ratio, s.samples, cut_took_ms);
+    ASSERT_EQ(said_ms.count(r.robot), 1U) << r.robot << "'s serve did not say why:\n" << text;
+    EXPECT_LE(said_ms[r.robot], bound_ms) << r.robot;
+    EXPECT_GE(serve_ms, kDetectionMs) << text;
+    ASSERT_GT(s.slowing_ms, 0.0) << r.robot << " did not slow down after the cut (" << s.samples
+                                 << " samples in " << r.file << ")";
+    EXPECT_GT(s.slowing_ms, 0.5 * kDetectionMs) << r.robot << " slowed before it could know";
+    EXPECT_LE(s.slowing_ms, bound_ms) << r.robot;
+    ASSERT_GT(s.rest_ms, 0.0) << r.robot << " did not come to rest";
+    // At 5 mm/s the generator's stop takes a few samples; 1 s is a generous ceiling.
+    EXPECT_LE(s.rest_ms, bound_ms + 1000.0) << r.robot;
+    EXPECT_LE(s.accel_ratio, 1.0 + rccl::kAccelerationTolerance) << r.robot;
+  }
+  hosts.cut(false);
+  program.stop();
+  puma.stop();
+  microbo.stop();
+  std::remove(file_a.c_str());
+  std::remove(file_b.c_str());
+}
+
+// TODO(issue 29, integrator): the thesis's demonstration itself across the namespaces, once
+// examples/10_circuit_board runs with --remote --domain D --interface IF (scripts/demo-distributed)
+// on this branch: the PUMA's and the Microbo's serves in hosts a and b, the example with --remote
+// in host c, 2 ms and 1 % loss between them; assert its exit code 0 (every pad within its error
+// bound).
+TEST(NetHosts, TheCircuitBoardDemonstrationAcrossHostsMeetsItsErrorBound) {
+  NETNS_OR_SKIP();
+  GTEST_SKIP() << "the distributed demonstration (examples/10_circuit_board --remote, "
+                  "scripts/demo-distributed) is not on this branch yet; the integrator enables "
+                  "this test when it is";
+}
