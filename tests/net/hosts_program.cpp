@@ -2,7 +2,7 @@
 // namespace of its own (tests/net/netns_fixture.hpp) on the interface given.
 //
 //   rccx_net_hosts_program track  CELL DOMAIN DETECTION_MS INTERFACE
-//     Places the PUMA over the board and then, gated on its end, the Microbo 150 mm to +x; the
+//     Places the Microbo and then, gated on its end, the PUMA over the board 150 mm to -x; the
 //     Microbo follows the PUMA's tool frame (other process) while the PUMA goes 30 mm along y and
 //     back at 20 mm/s. Prints "reached <n> of <m> motions", the tracking error from the robots'
 //     states matched by stamp ("tracking: worst W mm rms R mm over N samples"), and exits 0 when
@@ -117,6 +117,22 @@ std::string reasons(net::RemoteArm& arm) {
   return s;
 }
 
+/// What is known of a motion that failed with no failure event: the robot's state and events.
+std::string unexplained(net::RemoteArm& arm) {
+  const net::RemoteState st = arm.state();
+  std::string why =
+      "no failure event in 3 s; its state: status " + std::to_string(static_cast<int>(st.status)) +
+      ", control ended " + std::to_string(st.control_ended) + ", running " +
+      std::to_string(st.running) + ", queued " + std::to_string(st.queued) + ", started up to " +
+      std::to_string(st.started_upto) + ", ended up to " + std::to_string(st.ended_upto) +
+      ", termination '" + st.termination + "'; events:";
+  for (const auto& e : arm.take_events()) {
+    why += " [" + std::to_string(e.id) + " kind " + std::to_string(static_cast<int>(e.kind)) + " " +
+           std::string(e.message()) + "]";
+  }
+  return why;
+}
+
 /// Counts and names the motions that did not reach their end.
 struct Tally {
   int reached = 0, total = 0;
@@ -128,13 +144,20 @@ struct Tally {
       ++reached;
       return;
     }
-    why += std::string(what) + ": " +
-           (r == rccl::WaitResult::timeout ? "timeout" : "failed: " + reasons(arm)) + "\n";
+    // The failure's event (reliable, with its reason) may come after the state that told
+    // the ledger.
+    for (int i = 0; i < 300 && r == rccl::WaitResult::failed && arm.failures().empty(); ++i) {
+      std::this_thread::sleep_for(10ms);
+    }
+    why += std::string(what) + " (motion " + std::to_string(m.id) +
+           "): " + (r == rccl::WaitResult::timeout ? "timeout" : "failed: " + reasons(arm));
+    if (arm.failures().empty()) why += unexplained(arm);
+    why += "\n";
   }
 };
 
-/// The PUMA over the board pointing down; then, gated on its end, the Microbo 150 mm to +x (the
-/// geometry of net_serve_test's follow test).
+/// The Microbo 150 mm to +x of the board's point; then, gated on its end, the PUMA over that
+/// point pointing down (the geometry of net_serve_test's follow test).
 void place(net::RemoteCell& cell, Tally& tally) {
   net::RemoteArm& puma = cell.robot("puma");
   net::RemoteArm& microbo = cell.robot("microbo");
@@ -142,11 +165,17 @@ void place(net::RemoteCell& cell, Tally& tally) {
   puma.set_velocity(0.05, 0.5);
   microbo.set_mode(rccl::Mode::joint);
   microbo.set_velocity(0.05, 0.5);
-  const rccl::Motion p1 = puma.move(cell.world_goal("puma", "OVER", tool_down(-0.05, 0.0, 0.1516)));
-  const rccl::Motion m0 = microbo.move(
-      cell.world_goal("microbo", "M0", tool_down(0.10, 0.0, 0.1516)), cell.after("puma", p1.end()));
-  tally.wait(puma, p1, "puma OVER");
-  tally.wait(microbo, m0, "microbo M0 (after puma OVER)");
+  // The Microbo's ready pose is in the PUMA's way to the board: it moves aside first.
+  const rccl::Motion m0 =
+      microbo.move(cell.world_goal("microbo", "M0", tool_down(0.10, 0.0, 0.1516)));
+  const rccl::Motion p1 = puma.move(cell.world_goal("puma", "OVER", tool_down(-0.05, 0.0, 0.1516)),
+                                    cell.after("microbo", m0.end()));
+  tally.wait(microbo, m0, "microbo M0");
+  tally.wait(puma, p1, "puma OVER (after microbo M0)");
+  std::this_thread::sleep_for(100ms);  // both at rest in each other's states
+  const math::Vec3 a = puma.state().tool.pose.p, b = microbo.state().tool.pose.p;
+  std::printf("placed: puma's tool at (%.4f, %.4f, %.4f) m, microbo's at (%.4f, %.4f, %.4f) m\n",
+              a.x, a.y, a.z, b.x, b.y, b.z);
 }
 
 /// The largest and rms distance (m) of the Microbo's tool from the PUMA's + 150 mm x at the
@@ -190,6 +219,10 @@ int track(char** argv) {
   net::RemoteArm& microbo = cell.robot("microbo");
   Tally tally;
   place(cell, tally);
+  if (tally.reached != tally.total) {
+    std::printf("placing failed:\n%s", tally.why.c_str());
+    return 3;
+  }
   const auto offset = rccl::constant("BESIDE", math::Transform::translation(0.15, 0, 0));
   microbo.set_mode(rccl::Mode::joint);
   const rccl::Motion f1 =
@@ -272,6 +305,10 @@ int long_motion(char** argv) {
       w.done = true;
       if (r == rccl::WaitResult::failed) {
         ++failed;
+        if (w.arm->failures().empty()) {
+          std::printf("(motion %llu of %s: %s)\n", static_cast<unsigned long long>(w.motion.id),
+                      w.arm->name().c_str(), unexplained(*w.arm).c_str());
+        }
         std::printf("failed %s %lld %s\n", w.arm->name().c_str(),
                     static_cast<long long>(steady_ns()), reasons(*w.arm).c_str());
       } else {
