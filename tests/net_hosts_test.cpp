@@ -342,7 +342,8 @@ void cut_once(int attempt, bool& again) {
                       << program.output() << "\nhost a:\n"
                       << puma.output() << "\nhost b:\n"
                       << microbo.output();
-  std::this_thread::sleep_for(1500ms);  // cruising at 5 mm/s, 4.5 s of the motion left
+  std::this_thread::sleep_for(
+      1000ms);  // the PUMA cruising at 10 mm/s (2 s left), the Microbo with it
 
   const std::int64_t cut_steady = steady_ns();
   const std::int64_t cut_wall = net::wall_ns();
@@ -415,7 +416,7 @@ void cut_once(int attempt, bool& again) {
     EXPECT_GT(s.slowing_ms, 0.5 * kDetectionMs) << r.robot << " slowed before it could know";
     EXPECT_LE(s.slowing_ms, bound_ms) << r.robot;
     ASSERT_GT(s.rest_ms, 0.0) << r.robot << " did not come to rest";
-    // At 5 mm/s the generator's stop takes a few samples; 1 s is a generous ceiling.
+    // At 10 mm/s the generator's stop takes a few samples; 1 s is a generous ceiling.
     EXPECT_LE(s.rest_ms, bound_ms + 1000.0) << r.robot;
     EXPECT_LE(s.accel_ratio, 1.0 + rccl::kAccelerationTolerance) << r.robot;
   }

@@ -8,9 +8,10 @@
 //     states matched by stamp ("tracking: worst W mm rms R mm over N samples"), and exits 0 when
 //     every motion reached its end, 3 when one did not (its reason printed).
 //   rccx_net_hosts_program long   CELL DOMAIN DETECTION_MS INTERFACE
-//     Places them as above, then moves both 30 mm along y at 5 mm/s (6 s), prints
-//     "moving <steady ns>" and then, for each robot whose motion fails, "failed <robot> <steady ns>
-//     <reason>"; exits 0 when both failed, 3 when one reached its end or 30 s passed.
+//     Places them and starts the Microbo's tracking as above, then moves the PUMA 30 mm along y
+//     at 10 mm/s (3 s), prints "moving <steady ns>" and then "failed <robot> <steady ns> <reason>"
+//     when the PUMA's motion fails and when the Microbo's failures() report it (its motion,
+//     tracking at rest, has ended); exits 0 when both did, 3 otherwise (30 s at most).
 //   rccx_net_hosts_program record DOMAIN DETECTION_MS INTERFACE FILE
 //     Writes every RobotState it receives to FILE, one line each, until SIGTERM:
 //     "<robot> <sample> <stamp_ns> <received steady ns> <period_s> <status> <q1..qn>".
@@ -178,6 +179,21 @@ void place(net::RemoteCell& cell, Tally& tally) {
               a.x, a.y, a.z, b.x, b.y, b.z);
 }
 
+/// The Microbo onto the PUMA's tool frame + 150 mm x, then tracking it (Cartesian mode goes on
+/// tracking its goal once there: net_serve_test's follow test).
+void follow(net::RemoteCell& cell, Tally& tally) {
+  net::RemoteArm& microbo = cell.robot("microbo");
+  const auto offset = rccl::constant("BESIDE", math::Transform::translation(0.15, 0, 0));
+  microbo.set_mode(rccl::Mode::joint);
+  const rccl::Motion f1 =
+      microbo.move(cell.world_goal("microbo", "FOLLOW", {cell.tool_frame("puma"), offset}));
+  tally.wait(microbo, f1, "microbo FOLLOW (joint)");
+  microbo.set_mode(rccl::Mode::cartesian);
+  const rccl::Motion f2 =
+      microbo.move(cell.world_goal("microbo", "FOLLOW", {cell.tool_frame("puma"), offset}));
+  tally.wait(microbo, f2, "microbo FOLLOW (Cartesian)");
+}
+
 /// The largest and rms distance (m) of the Microbo's tool from the PUMA's + 150 mm x at the
 /// Microbo's stamps in [from_ns, to_ns], the PUMA's interpolated between its two samples around
 /// each stamp (none more than 3 of its periods apart).
@@ -216,23 +232,13 @@ int track(char** argv) {
   ro.wait_for_robots = 30s;  // discovery across a lossy, delayed link on a loaded machine
   net::RemoteCell cell(cell::load_cell_file(argv[2]), o, ro);
   net::RemoteArm& puma = cell.robot("puma");
-  net::RemoteArm& microbo = cell.robot("microbo");
   Tally tally;
   place(cell, tally);
   if (tally.reached != tally.total) {
     std::printf("placing failed:\n%s", tally.why.c_str());
     return 3;
   }
-  const auto offset = rccl::constant("BESIDE", math::Transform::translation(0.15, 0, 0));
-  microbo.set_mode(rccl::Mode::joint);
-  const rccl::Motion f1 =
-      microbo.move(cell.world_goal("microbo", "FOLLOW", {cell.tool_frame("puma"), offset}));
-  tally.wait(microbo, f1, "microbo FOLLOW (joint)");
-  // Cartesian: the Microbo goes on tracking its goal once there (net_serve_test's follow test).
-  microbo.set_mode(rccl::Mode::cartesian);
-  const rccl::Motion f2 =
-      microbo.move(cell.world_goal("microbo", "FOLLOW", {cell.tool_frame("puma"), offset}));
-  tally.wait(microbo, f2, "microbo FOLLOW (Cartesian)");
+  follow(cell, tally);
   puma.set_mode(rccl::Mode::cartesian);
   puma.set_velocity(0.02, 0.3);
   const std::int64_t from = net::wall_ns();
@@ -268,55 +274,51 @@ int long_motion(char** argv) {
   net::RemoteArm& microbo = cell.robot("microbo");
   Tally tally;
   place(cell, tally);
+  if (tally.reached == tally.total) follow(cell, tally);
   if (tally.reached != tally.total) {
     std::printf("placing failed:\n%s", tally.why.c_str());
     return 3;
   }
-  // Side by side 150 mm apart, the same way: never nearer each other.
-  for (net::RemoteArm* arm : {&puma, &microbo}) {
-    arm->set_mode(rccl::Mode::cartesian);
-    arm->set_velocity(0.005, 0.1);
-  }
+  // The PUMA 30 mm along y at 10 mm/s (3 s) and the Microbo tracking it, 150 mm beside.
+  puma.set_mode(rccl::Mode::cartesian);
+  puma.set_velocity(0.01, 0.3);
   const rccl::Motion lp =
       puma.move(cell.world_goal("puma", "LONG", tool_down(-0.05, 0.03, 0.1516)));
-  const rccl::Motion lm =
-      microbo.move(cell.world_goal("microbo", "LONG", tool_down(0.10, 0.03, 0.1516)));
-  if (puma.waitfor(lp.start(), 10s) != rccl::WaitResult::reached ||
-      microbo.waitfor(lm.start(), 10s) != rccl::WaitResult::reached) {
-    std::printf("the long motions did not start: %s %s\n", reasons(puma).c_str(),
-                reasons(microbo).c_str());
+  if (puma.waitfor(lp.start(), 10s) != rccl::WaitResult::reached) {
+    std::printf("the long motion did not start: %s\n", reasons(puma).c_str());
     return 3;
   }
   std::printf("moving %lld\n", static_cast<long long>(steady_ns()));
   std::fflush(stdout);
-  struct Watch {
-    net::RemoteArm* arm;
-    rccl::Motion motion;
-    bool done = false;
-  };
-  Watch watches[2] = {{&puma, lp}, {&microbo, lm}};
+  // The PUMA's motion fails; the Microbo's (ended, tracking at rest) is reported by the robot's
+  // loss in failures().
+  bool puma_done = false, microbo_done = false;
   int failed = 0;
   const auto until = std::chrono::steady_clock::now() + 30s;
-  while (std::chrono::steady_clock::now() < until && !(watches[0].done && watches[1].done)) {
-    for (Watch& w : watches) {
-      if (w.done) continue;
-      const rccl::WaitResult r = w.arm->waitfor(w.motion.end(), 2ms);
-      if (r == rccl::WaitResult::timeout) continue;
-      w.done = true;
-      if (r == rccl::WaitResult::failed) {
-        ++failed;
-        if (w.arm->failures().empty()) {
-          std::printf("(motion %llu of %s: %s)\n", static_cast<unsigned long long>(w.motion.id),
-                      w.arm->name().c_str(), unexplained(*w.arm).c_str());
+  while (std::chrono::steady_clock::now() < until && !(puma_done && microbo_done)) {
+    if (!puma_done) {
+      const rccl::WaitResult r = puma.waitfor(lp.end(), 2ms);
+      if (r != rccl::WaitResult::timeout) {
+        puma_done = true;
+        if (r == rccl::WaitResult::failed) {
+          ++failed;
+          std::printf("failed puma %lld %s\n", static_cast<long long>(steady_ns()),
+                      reasons(puma).c_str());
+          if (puma.failures().empty()) std::printf("(puma: %s)\n", unexplained(puma).c_str());
+        } else {
+          std::printf("reached puma %lld\n", static_cast<long long>(steady_ns()));
         }
-        std::printf("failed %s %lld %s\n", w.arm->name().c_str(),
-                    static_cast<long long>(steady_ns()), reasons(*w.arm).c_str());
-      } else {
-        std::printf("reached %s %lld\n", w.arm->name().c_str(),
-                    static_cast<long long>(steady_ns()));
+        std::fflush(stdout);
       }
+    }
+    if (!microbo_done && !microbo.failures().empty()) {
+      microbo_done = true;
+      ++failed;
+      std::printf("failed microbo %lld %s\n", static_cast<long long>(steady_ns()),
+                  reasons(microbo).c_str());
       std::fflush(stdout);
     }
+    std::this_thread::sleep_for(1ms);
   }
   return failed == 2 ? 0 : 3;
 }
