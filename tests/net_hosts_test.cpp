@@ -276,12 +276,14 @@ void track_once(int attempt, bool& again) {
   const double total = number_after(out, R"(of (\d+) motions)");
   EXPECT_GE(total, 6.0) << out;
   EXPECT_EQ(reached, total) << out;
-  // The Microbo's commanded tool against the PUMA's + 150 mm x at the same stamp. At 20 mm/s
-  // the Microbo's serve extrapolates the PUMA's newest state over its age (2 ms in transit, up to
-  // a 7 ms period, more when a state was lost): a velocity error during the PUMA's speed-up and
-  // slow-down of 20 mm/s x ~10 ms = 0.2 mm, and the Microbo's own generator following a moving
-  // goal at its 28 ms period (net_serve_test's loopback figure: under 5 mm). 5 mm holds both
-  // with the margin the one-process follow test has; the measured worst is printed.
+  // The Microbo's commanded tool against the PUMA's + 150 mm x at the same stamp (CLOCK_REALTIME,
+  // one clock for all namespaces). The Microbo's serve extrapolates the PUMA's newest state by its
+  // velocity over the state's age: 2 ms in transit, up to a 7 ms period, 7 ms more for each state
+  // the link lost. Unextrapolated, that age at 20 mm/s would be 0.2 mm to 0.5 mm behind; the
+  // extrapolation leaves only the PUMA's change of velocity over the age, during its speed-up and
+  // slow-down. Measured here: 0.12 to 0.15 mm. The bound, 1 mm, is 50 ms of the PUMA's travel:
+  // room for a burst of lost states and a loaded machine's stalls, and still five times tighter
+  // than the 5 mm the loopback follow test allows.
   const double worst_mm = number_after(out, R"(tracking: worst ([0-9.]+) mm)");
   const double count = number_after(out, R"(over (\d+) samples)");
   std::printf(
@@ -290,7 +292,7 @@ void track_once(int attempt, bool& again) {
       worst_mm, count);
   EXPECT_GE(count, 50.0) << "too few samples matched: " << out;
   EXPECT_GE(worst_mm, 0.0) << out;
-  EXPECT_LT(worst_mm, 5.0) << out;
+  EXPECT_LT(worst_mm, 1.0) << out;
   // Nobody took a peer for lost on the way: not the serves, not the program.
   for (const std::string* text : {&pa, &mb, &out}) {
     EXPECT_FALSE(contains(*text, "was lost (no heartbeat")) << *text;
