@@ -335,7 +335,12 @@ void cut_once(int attempt, bool& again) {
   netns::Child program = spawn_rt(hosts, 2,
                                   {RCCX_HOSTS_PROGRAM, "long", kCell, d,
                                    std::to_string(kDetectionMs), netns::Hosts::kInterface});
-  const bool moving = program.wait_for_output("moving", 90s);
+  for (const auto until = Clock::now() + 90s; Clock::now() < until &&
+                                              !contains(program.output(), "moving") &&
+                                              !program.wait(0ms).has_value();) {
+    std::this_thread::sleep_for(5ms);
+  }
+  const bool moving = contains(program.output(), "moving");
   if (!moving && attempt < kAttempts && overran(program.output(), attempt)) {
     again = true;
     return;
