@@ -106,6 +106,12 @@ std::string read_file(const std::string& path) {
   return s.str();
 }
 
+/// A file deleted when this goes (after a failed assertion too).
+struct RemovedAtEnd {
+  std::string path;
+  ~RemovedAtEnd() { std::remove(path.c_str()); }
+};
+
 /// One RobotState as a recorder in the serve's own host received it.
 struct Sample {
   std::uint64_t sample = 0;
@@ -324,6 +330,7 @@ void cut_once(int attempt, bool& again) {
   // Recorders beside each serve: what it commands stays visible to them through the cut.
   const std::string file_a = ::testing::TempDir() + "rccx_hosts_a_" + d + ".txt";
   const std::string file_b = ::testing::TempDir() + "rccx_hosts_b_" + d + ".txt";
+  const RemovedAtEnd remove_a{file_a}, remove_b{file_b};
   netns::Child rec_a = spawn_rt(hosts, 0,
                                 {RCCX_HOSTS_PROGRAM, "record", d, std::to_string(kDetectionMs),
                                  netns::Hosts::kInterface, file_a});
@@ -345,12 +352,12 @@ void cut_once(int attempt, bool& again) {
     again = true;
     return;
   }
-  ASSERT_TRUE(moving) << "the long motions did not start:\n"
+  ASSERT_TRUE(moving) << "the long motion did not start:\n"
                       << program.output() << "\nhost a:\n"
                       << puma.output() << "\nhost b:\n"
                       << microbo.output();
-  std::this_thread::sleep_for(
-      1000ms);  // the PUMA cruising at 10 mm/s (2 s left), the Microbo with it
+  // The PUMA cruising at 10 mm/s (2 s of its motion left), the Microbo with it.
+  std::this_thread::sleep_for(1000ms);
 
   const std::int64_t cut_steady = steady_ns();
   const std::int64_t cut_wall = net::wall_ns();
@@ -431,8 +438,6 @@ void cut_once(int attempt, bool& again) {
   program.stop();
   puma.stop();
   microbo.stop();
-  std::remove(file_a.c_str());
-  std::remove(file_b.c_str());
 }
 
 TEST(NetHosts, WithTheLinkCutEachServeStopsItsRobotWithinTheDetectionTimeAndSaysWhy) {
