@@ -66,7 +66,7 @@ math::Transform tool_down(double x, double y, double z) {
   return t;
 }
 
-/// One robot's states as received: stamp (CLOCK_REALTIME ns the setpoint is for) -> tool.
+/// The robots' states as received: by robot, stamp (CLOCK_REALTIME ns the setpoint is for) -> tool.
 struct Track {
   std::mutex mutex;
   std::map<std::string, std::map<std::int64_t, math::Vec3>> tool;  ///< by robot, by stamp_ns
