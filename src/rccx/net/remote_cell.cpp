@@ -612,6 +612,15 @@ void RemoteCell::poll(std::int64_t now) {
           a->lost_.clear();
           a->mirror_->set_lost(false);
         }
+        // Control ended on the serve (an overrun, a fault): the waits that now fail say why.
+        if (restarted) a->end_said_ = false;
+        if (buf[i].terminate_code != 0 && !a->end_said_) {
+          a->end_said_ = true;
+          const std::string why = fmt::format("robot {}'s control ended on its serve process: {}",
+                                              a->name(), text_of(buf[i].termination));
+          a->failures_.push_back(lost_event(a->last_queued_, why));
+          io::eprint("rccx program: {}\n", why);
+        }
         changed = true;
       }
       if (n < static_cast<int>(buf.size())) break;

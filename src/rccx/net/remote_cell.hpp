@@ -159,7 +159,8 @@ class RemoteArm : public rccl::Arm {
   std::vector<rccl::MotionEvent> failures_copy_;  ///< program side: what failures() returned
   /// Program side's record of each motion's start and end times (s) from its events.
   std::map<std::uint64_t, rccl::SegmentReport> reports_;
-  std::string lost_;  ///< why the robot is lost ("" while it is alive)
+  std::string lost_;       ///< why the robot is lost ("" while it is alive)
+  bool end_said_ = false;  ///< its control's end is in failures_ already
 };
 
 /// A stream a program writes for its robots' equations ("stream:<name>", FrameSample).

@@ -87,6 +87,7 @@ struct RobotServer::Local {
   Slot slot;
   bool have_slot = false;
   std::int64_t written_ns = 0;  ///< steady, last state written
+  bool end_said = false;        ///< its control's end was said on stderr
   std::string program;          ///< attached program ("" none)
   std::uint64_t program_instance = 0;
   std::int64_t attached_ns = 0;
@@ -752,9 +753,16 @@ void RobotServer::publish_states(std::int64_t now, bool last) {
       s.status = static_cast<std::uint8_t>(RobotStatus::ended);
       s.terminate_code = static_cast<std::int16_t>(code);
       const rtc::Termination term = l.session->termination();
-      copy_to(s.termination,
-              term.message_view().empty() ? term.detail_view() : term.message_view());
+      const std::string_view why =
+          term.message_view().empty() ? term.detail_view() : term.message_view();
+      copy_to(s.termination, why);
       s.control_ended = true;
+      if (!l.end_said) {  // once: what ended it (an overrun, a fault ...) is the user's first
+                          // question
+        l.end_said = true;
+        io::eprint("rccx serve: robot {}'s control ended: {}{}{}\n", l.name, rtc::describe(code),
+                   why.empty() ? "" : ": ", why);
+      }
     } else if (last) {
       s.status = static_cast<std::uint8_t>(RobotStatus::ended);
       copy_to(s.termination, "the serve process stopped");
