@@ -2,9 +2,15 @@
 // (make bench-net; scripts/bench-net puts these beside Cyclone's ddsperf ping/pong):
 //
 //   BM_NetRequestAckRoundtrip   a MotionRequest written, its MotionAck taken: p50/p99/max over
-//                               100,000 round trips. The responder is a STAND-IN for the serve
-//                               process (a child of this program that acknowledges each request
-//                               at once); the real `rccx serve` replaces it later.
+//                               100,000 round trips. The responder is a STAND-IN (a child of
+//                               this program acknowledging each request at once): rccx's types
+//                               and QoS without the serve's work.
+//   BM_ServeRequestAckWire      the same against a real `rccx serve` (kind attach: answered
+//                               without moving the robot), this process heartbeating as a program.
+//   BM_ServeRequestAckApi       RemoteArm::attach() through net::RemoteCell against the serve:
+//                               the round trip a program's call sees.
+//   BM_ServeStateOneWay         the serve's RobotState (the PUMA at the cell's rate, 1 kHz in
+//                               the script): written_ns to this reader's take, 100,000 states.
 //   BM_NetStateOneWay           RobotState from another process at 10 kHz: write (source
 //                               timestamp, CLOCK_REALTIME) to take, p50/p99/max over those of
 //                               110,000 written that the reader saw (keep last 1: it may miss
@@ -20,8 +26,10 @@
 // Each case runs once (its own timing inside); the figures are user counters (us). The children
 // are this program again (--net-role ...), so each side is a process of its own.
 // Environment: RCCX_BENCH_DOMAIN (else 150 + pid % 50), RCCX_BENCH_FLEET_SECONDS (3),
-// RCCX_BENCH_ROUNDTRIPS (100000), RCCX_BENCH_SECURE_DIR (DDS Security's files of rccx certs init,
-// identities "program" here and "puma" in the child; untried until secure mode is done).
+// RCCX_BENCH_ROUNDTRIPS (100000), RCCX_BENCH_STATE_SAMPLES (100000), RCCX_BENCH_RCCX and
+// RCCX_BENCH_CELL (the rccx executable and a cell file: the Serve cases skip without them),
+// RCCX_BENCH_SECURE_DIR (DDS Security's files of rccx certs init, identities "program" here and
+// "puma" in the child and the serve).
 // Diagnoses: RCCX_BENCH_LISTENER=1 (the responder answers from a listener, in Cyclone's receive
 // thread), RCCX_BENCH_KEEP_LAST=1 (request and ack reliable keep last 1, as ddsperf's ping/pong).
 #include <benchmark/benchmark.h>
@@ -37,13 +45,16 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <string_view>
 #include <thread>
 #include <vector>
 
+#include "rccx/cell/cell_model.hpp"
 #include "rccx/net/dds.hpp"
+#include "rccx/net/remote_cell.hpp"
 
 extern char** environ;
 
@@ -76,10 +87,27 @@ net::NetOptions options(std::uint32_t domain, const char* identity) {
 class Child {
  public:
   explicit Child(const std::vector<std::string>& args) {
-    int fds[2];
-    if (pipe(fds) != 0) throw std::runtime_error("pipe failed");
     std::vector<std::string> all{"/proc/self/exe", "--net-role"};
     all.insert(all.end(), args.begin(), args.end());
+    spawn(all);
+  }
+  /// Another program: argv[0] is its path.
+  struct Program {};
+  Child(Program, const std::vector<std::string>& argv) { spawn(argv); }
+  Child(const Child&) = delete;
+  Child& operator=(const Child&) = delete;
+  ~Child() { finish(0ms); }
+
+  /// SIGTERM (a serve's clean stop), then what finish() does.
+  std::string terminate(std::chrono::milliseconds grace) {
+    if (pid_ > 0) kill(pid_, SIGTERM);
+    return finish(grace);
+  }
+
+ private:
+  void spawn(std::vector<std::string> all) {
+    int fds[2];
+    if (pipe(fds) != 0) throw std::runtime_error("pipe failed");
     std::vector<char*> argv;
     for (std::string& a : all) argv.push_back(a.data());
     argv.push_back(nullptr);
@@ -87,16 +115,14 @@ class Child {
     posix_spawn_file_actions_init(&fa);
     posix_spawn_file_actions_adddup2(&fa, fds[1], STDOUT_FILENO);
     posix_spawn_file_actions_addclose(&fa, fds[0]);
-    const int rc = posix_spawn(&pid_, "/proc/self/exe", &fa, nullptr, argv.data(), environ);
+    const int rc = posix_spawn(&pid_, all[0].c_str(), &fa, nullptr, argv.data(), environ);
     posix_spawn_file_actions_destroy(&fa);
     close(fds[1]);
     out_ = fds[0];
-    if (rc != 0) throw std::runtime_error("posix_spawn of the bench's child failed");
+    if (rc != 0) throw std::runtime_error("posix_spawn of " + all[0] + " failed");
   }
-  Child(const Child&) = delete;
-  Child& operator=(const Child&) = delete;
-  ~Child() { finish(0ms); }
 
+ public:
   /// Waits up to `grace` for the child to end, then kills it; returns what it printed.
   std::string finish(std::chrono::milliseconds grace) {
     if (pid_ > 0) {
@@ -448,6 +474,207 @@ void BM_NetStateOneWay(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_NetStateOneWay)->Iterations(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// ---- against a real `rccx serve` -------------------------------------------------------------
+
+/// `rccx serve` of `robots` (RCCX_BENCH_RCCX: the rccx executable; RCCX_BENCH_CELL: its cell
+/// file), secured as "puma" when RCCX_BENCH_SECURE_DIR is set; nullptr (the case skips) when
+/// either is unset.
+std::unique_ptr<Child> start_serve(std::uint32_t domain, const char* robots) {
+  const char* rccx_exe = std::getenv("RCCX_BENCH_RCCX");
+  const char* cell = std::getenv("RCCX_BENCH_CELL");
+  if (rccx_exe == nullptr || cell == nullptr || *rccx_exe == '\0' || *cell == '\0') return nullptr;
+  std::vector<std::string> argv{rccx_exe,      "serve", "--cell",       cell,
+                                "--robots",    robots,  "--domain",     std::to_string(domain),
+                                "--interface", "lo",    "--claim-wait", "100ms",
+                                "--seconds",   "900"};
+  if (const char* dir = std::getenv("RCCX_BENCH_SECURE_DIR"); dir != nullptr && *dir != '\0') {
+    argv.insert(argv.end(), {"--secure", dir, "--identity", "puma"});
+  }
+  return std::make_unique<Child>(Child::Program{}, argv);
+}
+
+constexpr const char* kNoServe =
+    "set RCCX_BENCH_RCCX (the rccx executable) and RCCX_BENCH_CELL (a cell file) to run "
+    "against rccx serve (scripts/bench-net does)";
+
+/// The wire round trip against the real serve: this thread writes a MotionRequest of kind
+/// attach (answered without moving the robot at rest, through the serve's whole request path:
+/// its middleware thread woken, the dedup table, Manipulator::last_queued, the ack written) and
+/// takes its MotionAck from a waitset, as a program's middleware thread would; heartbeats as a
+/// program every 5 ms between round trips (outside the timed part), so the serve keeps it
+/// attached.
+void BM_ServeRequestAckWire(benchmark::State& state) {
+  const std::uint32_t domain = bench_domain();
+  const long roundtrips = env_long("RCCX_BENCH_ROUNDTRIPS", 100'000);
+  for (auto _ : state) {
+    const net::Participant p(options(domain, "program"));
+    const net::Entity requests = p.writer(net::Topic::request);
+    const net::Entity acks = p.reader(net::Topic::ack);
+    const net::Entity beats = p.writer(net::Topic::heartbeat);
+    const DataWait wait(p, acks.get());
+    const std::unique_ptr<Child> serve = start_serve(domain, "puma");
+    if (!serve) {
+      state.SkipWithError(kNoServe);
+      return;
+    }
+    if (!wait_for(
+            [&] { return writer_matches(requests.get()) > 0 && reader_matches(acks.get()) > 0; },
+            30s)) {
+      state.SkipWithError("rccx serve did not match in 30 s (see its stderr)");
+      return;
+    }
+    const std::string program = "program/bench-" + std::to_string(getpid());
+    rccx_net_Heartbeat hb{};
+    net::copy_to(hb.participant, program);
+    hb.role = static_cast<std::uint8_t>(net::Role::program);
+    hb.instance = 42;
+    hb.period_ns = 5'000'000;
+    hb.detection_ns = 20'000'000;
+    net::copy_to(hb.robots, "puma");
+    rccx_net_MotionRequest req{};
+    net::copy_to(req.robot, "puma");
+    net::copy_to(req.program, program);
+    req.program_instance = hb.instance;
+    req.kind = static_cast<std::uint8_t>(net::RequestKind::attach);
+    std::vector<std::int64_t> ns;
+    ns.reserve(static_cast<std::size_t>(roundtrips));
+    const long warmup = 2000;
+    auto beat_at = std::chrono::steady_clock::now();
+    for (long i = 1; i <= warmup + roundtrips; ++i) {
+      if (std::chrono::steady_clock::now() >= beat_at) {
+        ++hb.seq;
+        dds_write(beats.get(), &hb);
+        beat_at += 5ms;
+      }
+      req.request = static_cast<std::uint64_t>(i);
+      const auto t0 = std::chrono::steady_clock::now();
+      dds_write(requests.get(), &req);
+      bool acked = false;
+      while (!acked) {
+        // The first answers wait for the serve's cell to start.
+        if (!wait.wait(i == 1 ? DDS_SECS(20) : DDS_SECS(2))) {
+          state.SkipWithError("rccx serve sent no acknowledgement in 2 s");
+          return;
+        }
+        void* buf[4] = {};
+        dds_sample_info_t info[4];
+        const dds_return_t n = dds_take(acks.get(), buf, info, 4, 4);
+        for (dds_return_t k = 0; k < n; ++k) {
+          const auto* a = static_cast<const rccx_net_MotionAck*>(buf[k]);
+          acked = acked || (info[k].valid_data && a->request == req.request);
+        }
+        if (n > 0) dds_return_loan(acks.get(), buf, n);
+      }
+      const auto t1 = std::chrono::steady_clock::now();
+      if (i > warmup) ns.push_back((t1 - t0).count());
+    }
+    set_latency_counters(state, ns);
+    (void)serve->terminate(5s);
+  }
+}
+BENCHMARK(BM_ServeRequestAckWire)->Iterations(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+/// What a program sees: RemoteArm::attach() through net::RemoteCell (its request written from
+/// the calling thread, the ack taken by its middleware thread from a waitset and handed over
+/// through a condition variable) against the real serve.
+void BM_ServeRequestAckApi(benchmark::State& state) {
+  const std::uint32_t domain = bench_domain();
+  const long roundtrips = env_long("RCCX_BENCH_ROUNDTRIPS", 100'000);
+  for (auto _ : state) {
+    const std::unique_ptr<Child> serve = start_serve(domain, "puma");
+    if (!serve) {
+      state.SkipWithError(kNoServe);
+      return;
+    }
+    try {
+      net::RemoteOptions ro;
+      ro.robots = {"puma"};
+      ro.wait_for_robots = 30s;
+      net::RemoteCell cell(cell::load_cell_file(std::getenv("RCCX_BENCH_CELL")),
+                           options(domain, "program"), ro);
+      net::RemoteArm& puma = cell.robot("puma");
+      std::vector<std::int64_t> ns;
+      ns.reserve(static_cast<std::size_t>(roundtrips));
+      const long warmup = 2000;
+      for (long i = 1; i <= warmup + roundtrips; ++i) {
+        const auto t0 = std::chrono::steady_clock::now();
+        puma.attach();
+        const auto t1 = std::chrono::steady_clock::now();
+        if (i > warmup) ns.push_back((t1 - t0).count());
+      }
+      set_latency_counters(state, ns);
+    } catch (const std::exception& e) {
+      state.SkipWithError(e.what());
+      return;
+    }
+    (void)serve->terminate(5s);
+  }
+}
+BENCHMARK(BM_ServeRequestAckApi)->Iterations(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+/// The serve's RobotState one way: its written_ns (CLOCK_REALTIME, as the middleware thread
+/// writes it) to this reader's take (same clock, same host), over RCCX_BENCH_STATE_SAMPLES
+/// (100,000) states of the PUMA at its sample rate (the script's cell: 1 ms; the Microbo's
+/// link needs 11.3 ms at least, so it is not served here).
+/// Also counts the samples missed (gaps in each robot's sample numbers).
+void BM_ServeStateOneWay(benchmark::State& state) {
+  const std::uint32_t domain = bench_domain();
+  const long want = env_long("RCCX_BENCH_STATE_SAMPLES", 100'000);
+  for (auto _ : state) {
+    const net::Participant p(options(domain, "program"));
+    const net::Entity states = p.reader(net::Topic::state);
+    const DataWait wait(p, states.get());
+    const std::unique_ptr<Child> serve = start_serve(domain, "puma");
+    if (!serve) {
+      state.SkipWithError(kNoServe);
+      return;
+    }
+    std::vector<std::int64_t> ns;
+    ns.reserve(static_cast<std::size_t>(want));
+    std::uint64_t last = 0;
+    long lost = 0;
+    long warm = 0;  // the first 1,000 states (the cell starting) are left out
+    std::uint64_t first_sample = 0;
+    std::int64_t first_ns = 0;
+    std::int64_t last_ns = 0;
+    const auto limit = std::chrono::steady_clock::now() + 60s + std::chrono::seconds(want / 500);
+    // (want / 500 s: twice the time 1 kHz needs.)
+    while (static_cast<long>(ns.size()) < want && std::chrono::steady_clock::now() < limit) {
+      if (!wait.wait(DDS_MSECS(500))) continue;
+      void* buf[8] = {};
+      dds_sample_info_t info[8];
+      const dds_return_t n = dds_take(states.get(), buf, info, 8, 8);
+      const std::int64_t now = net::wall_ns();
+      for (dds_return_t k = 0; k < n; ++k) {
+        if (!info[k].valid_data) continue;
+        const auto* s = static_cast<const rccx_net_RobotState*>(buf[k]);
+        if (last > 0 && s->sample > last + 1 && warm >= 1000) {
+          lost += static_cast<long>(s->sample - last - 1);
+        }
+        last = s->sample;
+        if (++warm > 1000) {
+          if (ns.empty()) {
+            first_sample = s->sample;
+            first_ns = now;
+          }
+          last_ns = now;
+          ns.push_back(now - s->written_ns);
+        }
+      }
+      if (n > 0) dds_return_loan(states.get(), buf, n);
+    }
+    (void)serve->terminate(5s);
+    set_latency_counters(state, ns);
+    state.counters["lost"] = static_cast<double>(lost);
+    // The serve's pace: its samples a second of the wall clock (below 1,000: it overran).
+    state.counters["rate_hz"] = last_ns > first_ns
+                                    ? static_cast<double>(last - first_sample) * 1e9 /
+                                          static_cast<double>(last_ns - first_ns)
+                                    : 0.0;
+  }
+}
+BENCHMARK(BM_ServeStateOneWay)->Iterations(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void state_fleet(benchmark::State& state, bool batch) {
   const std::uint32_t domain = bench_domain();

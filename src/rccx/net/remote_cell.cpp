@@ -68,7 +68,8 @@ std::string robots_of(const cell::CellModel& model) {
 
 /// The middleware thread decides that a peer is lost within the detection time, so it runs
 /// above ordinary threads when the process may (SCHED_FIFO at the lowest priority, below the
-/// control tasks'); otherwise as it is. It sleeps 1 ms every pass, so it cannot starve others.
+/// control tasks'); otherwise as it is. It sleeps whenever nothing is pending, and each pass
+/// does a bounded amount of work, so it cannot starve others.
 void raise_priority() noexcept {
   sched_param p{};
   p.sched_priority = sched_get_priority_min(SCHED_FIFO);
@@ -435,6 +436,28 @@ RemoteCell::RemoteCell(cell::CellModel model, NetOptions net, RemoteOptions opti
   state_reader_ = participant_->reader(Topic::state, net_.detection * 10);
   ack_reader_ = participant_->reader(Topic::ack);
   event_reader_ = participant_->reader(Topic::event);
+  waitset_ = Entity(check(dds_create_waitset(participant_->get()), "a waitset"));
+  const auto ready = [&](const Entity& reader) {
+    // Any sample the reader holds: the thread takes them all each pass.
+    Entity c(check(dds_create_readcondition(reader.get(), DDS_ANY_STATE), "a read condition"));
+    check(dds_waitset_attach(waitset_.get(), c.get(), 0), "a waitset's condition");
+    return c;
+  };
+  state_ready_ = ready(state_reader_);
+  event_ready_ = ready(event_reader_);
+  wake_guard_ = Entity(check(dds_create_guardcondition(participant_->get()), "a guard condition"));
+  check(dds_waitset_attach(waitset_.get(), wake_guard_.get(), 0), "a waitset's condition");
+  {
+    // Answers taken as they arrive, in Cyclone's receive thread, and handed to the waiting
+    // call: one thread hand-over less a request than through the middleware thread
+    // (docs/PERFORMANCE.md, "Network").
+    dds_listener_t* l = dds_create_listener(this);
+    dds_lset_data_available(
+        l, [](dds_entity_t, void* self) { static_cast<RemoteCell*>(self)->take_acks(); });
+    const dds_return_t rc = dds_set_listener(ack_reader_.get(), l);
+    dds_delete_listener(l);
+    check(rc, "the answers' listener");
+  }
   thread_ = std::thread([this] { run(); });
   // Every robot's state, and the request readers of their serve processes matched.
   const std::int64_t until = steady_ns() + options_.wait_for_robots.count();
@@ -454,7 +477,9 @@ RemoteCell::RemoteCell(cell::CellModel model, NetOptions net, RemoteOptions opti
     if (missing == nullptr && st.current_count >= serves.size()) break;
     if (steady_ns() >= until) {
       lock.unlock();
+      (void)dds_set_listener(ack_reader_.get(), nullptr);  // before mutex_ and acks_ go
       stop_.store(true);
+      (void)dds_set_guardcondition(wake_guard_.get(), true);
       thread_.join();
       if (missing != nullptr) {
         throw NetError(fmt::format(
@@ -475,7 +500,11 @@ void RemoteCell::start() {
 }
 
 RemoteCell::~RemoteCell() {
+  // Cyclone waits for a listener call under way: none runs after this (mutex_ and acks_ go
+  // before the reader).
+  (void)dds_set_listener(ack_reader_.get(), nullptr);
   stop_.store(true);
+  (void)dds_set_guardcondition(wake_guard_.get(), true);
   if (thread_.joinable()) thread_.join();
 }
 
@@ -570,8 +599,38 @@ void RemoteCell::run() noexcept {
       poll(steady_ns());
     } catch (const std::exception& e) {
       io::eprint("rccx program: the network thread: {}\n", e.what());
+      std::this_thread::sleep_for(1ms);  // not a busy loop on a lasting failure
     }
-    std::this_thread::sleep_for(1ms);
+    if (stop_.load()) break;
+    // Until data arrives (an answer is taken and handed over at once), the stop guard, or
+    // the next heartbeat or loss deadline.
+    const std::int64_t now = steady_ns();
+    const std::int64_t until =
+        std::min(last_heartbeat_ns_ + net_.heartbeat.count(), next_loss_check_ns_);
+    (void)dds_waitset_wait(waitset_.get(), nullptr, 0, std::max<std::int64_t>(until - now, 0));
+  }
+}
+
+void RemoteCell::take_acks() noexcept {
+  try {
+    rccx_net_MotionAck buf[8];
+    void* ptrs[8];
+    dds_sample_info_t info[8];
+    for (std::size_t i = 0; i < 8; ++i) ptrs[i] = &buf[i];
+    bool changed = false;
+    for (;;) {
+      const dds_return_t n = dds_take(ack_reader_.get(), ptrs, info, 8, 8);
+      for (dds_return_t i = 0; i < n; ++i) {
+        if (!info[i].valid_data || text_of(buf[i].program) != participant_name_) continue;
+        std::lock_guard lock(mutex_);
+        acks_.push_back(buf[i]);
+        if (acks_.size() > 1024) acks_.erase(acks_.begin());
+        changed = true;
+      }
+      if (n < 8) break;
+    }
+    if (changed) changed_.notify_all();
+  } catch (...) {  // push_back's bad_alloc: the call's resend asks again
   }
 }
 
@@ -627,22 +686,6 @@ void RemoteCell::poll(std::int64_t now) {
     }
   }
   {
-    std::vector<rccx_net_MotionAck> buf(8);
-    std::vector<void*> ptrs(buf.size());
-    std::vector<dds_sample_info_t> info(buf.size());
-    for (;;) {
-      const int n = take(ack_reader_.get(), buf, ptrs, info);
-      for (int i = 0; i < n; ++i) {
-        if (!info[i].valid_data || text_of(buf[i].program) != participant_name_) continue;
-        std::lock_guard lock(mutex_);
-        acks_.push_back(buf[i]);
-        if (acks_.size() > 1024) acks_.erase(acks_.begin());
-        changed = true;
-      }
-      if (n < static_cast<int>(buf.size())) break;
-    }
-  }
-  {
     std::vector<rccx_net_MotionEvent> buf(16);
     std::vector<void*> ptrs(buf.size());
     std::vector<dds_sample_info_t> info(buf.size());
@@ -671,11 +714,16 @@ void RemoteCell::poll(std::int64_t now) {
     }
   }
   // A robot whose serve process is silent for the detection time is lost.
+  next_loss_check_ns_ = INT64_MAX;
   for (auto& a : arms_) {
     std::lock_guard lock(mutex_);
     if (!a->state_ || !a->lost_.empty()) continue;
     const std::int64_t silent = now - a->mirror_->received_ns();
-    if (silent <= net_.detection.count()) continue;
+    if (silent <= net_.detection.count()) {
+      next_loss_check_ns_ =
+          std::min(next_loss_check_ns_, a->mirror_->received_ns() + net_.detection.count() + 1);
+      continue;
+    }
     a->lost_ = fmt::format("robot {} lost: its serve process {} is silent for {:.0f} ms", a->name(),
                            a->mirror_->participant(), ms_of(silent));
     a->mirror_->set_lost(true);

@@ -14,7 +14,9 @@
 // by default) is lost: waits on it return failed and failures() says why; a restarted serve
 // is announced on stderr and the robot can be used again. Threads: the program's calls (one
 // thread, as with a Manipulator) and one middleware thread (heartbeats, states, answers,
-// events) that polls every 1 ms.
+// events) that sleeps on a Cyclone waitset: woken at once by an event or a state, else at its
+// next heartbeat or a robot's loss deadline. Answers to requests are taken in Cyclone's receive
+// thread (a listener) and handed straight to the waiting call.
 #pragma once
 
 #include <atomic>
@@ -220,6 +222,9 @@ class RemoteCell : public cell::Workcell {
   friend class FrameStream;
   void run() noexcept;
   void poll(std::int64_t now);
+  /// Takes this program's answers into acks_ and wakes the waiting call; run by Cyclone's
+  /// receive thread (a data-available listener on ack_reader_).
+  void take_acks() noexcept;
   [[nodiscard]] RemoteArm* find(std::string_view name) noexcept;
 
   cell::CellModel model_;
@@ -239,6 +244,10 @@ class RemoteCell : public cell::Workcell {
   std::atomic<bool> stop_{false};
   std::int64_t last_heartbeat_ns_ = 0;
   std::uint64_t heartbeat_seq_ = 0;
+  std::int64_t next_loss_check_ns_ = INT64_MAX;  ///< steady: the earliest a robot may be lost
+  // The middleware thread's waitset: read conditions on the state and event readers, and a
+  // guard condition the destructor triggers. After the readers: deleted before them.
+  Entity waitset_, state_ready_, event_ready_, wake_guard_;
 };
 
 }  // namespace rccx::net

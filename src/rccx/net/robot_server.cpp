@@ -64,7 +64,8 @@ int take(dds_entity_t reader, std::vector<T>& buf, std::vector<void*>& ptrs,
 
 /// The middleware thread decides that a peer is lost within the detection time, so it runs
 /// above ordinary threads when the process may (SCHED_FIFO at the lowest priority, below the
-/// control tasks'); otherwise as it is. It sleeps 1 ms every pass, so it cannot starve others.
+/// control tasks'); otherwise as it is. It sleeps whenever nothing is pending, and each pass
+/// does a bounded amount of work, so it cannot starve others.
 void raise_priority() noexcept {
   sched_param p{};
   p.sched_priority = sched_get_priority_min(SCHED_FIFO);
@@ -294,6 +295,7 @@ void RobotServer::start() {
     ack_writer_ = participant_->writer(Topic::ack);
     event_writer_ = participant_->writer(Topic::event);
     frame_reader_ = participant_->reader(Topic::frame);
+    listen();
 
     cell::CellOptions co;
     co.clock = rtc::ClockKind::real_time;
@@ -335,6 +337,7 @@ void RobotServer::stop() {
   if (!started_ || stopped_) return;
   stopped_ = true;
   stop_.store(true);
+  rtc::detail::ring(wake_);
   if (thread_.joinable()) thread_.join();
   release_claims();
   cell_.reset();  // ends control
@@ -343,6 +346,7 @@ void RobotServer::stop() {
 // --- The control task's part -----------------------------------------------------------------
 
 void RobotServer::on_cycle() noexcept {
+  bool fresh = false;
   try {
     for (auto& lp : locals_) {
       Local& l = *lp;
@@ -365,9 +369,13 @@ void RobotServer::on_cycle() noexcept {
       s.stamp_ns = wall_ns() + static_cast<std::int64_t>((t - s.tool.t_s) * 1e9) +
                    static_cast<std::int64_t>(2.0 * l.period_s * 1e9);
       l.latest.publish(s);
+      fresh = true;
     }
   } catch (...) {  // tool_sample of a known robot does not throw
   }
+  // One atomic add, and a futex wake only when the middleware thread sleeps: no lock, no DDS
+  // call here (dds_set_guardcondition would take Cyclone's global handle lock and three more).
+  if (fresh) rtc::detail::ring(wake_);
 }
 
 // --- The middleware thread -------------------------------------------------------------------
@@ -376,8 +384,11 @@ void RobotServer::run() noexcept {
   try {
     if (options_.real_time_scheduling) raise_priority();
     while (!stop_.load()) {
+      // The bell's count before the pass: a ring during it makes the wait return at once.
+      const std::uint32_t seen = wake_.load();
       poll();
-      std::this_thread::sleep_for(1ms);
+      // No spinning: a request comes seldom, and a tick's ring wakes the futex directly.
+      rtc::detail::wait_while(wake_, seen, next_wake(), 0);
     }
     // Stopping: halt every robot, let them come to rest (bounded), say so in a last state.
     for (auto& l : locals_) halt_with(*l, "the serve process is stopping: stopped smoothly");
@@ -422,6 +433,31 @@ void RobotServer::poll() {
     last_heartbeat_ns_ = now;
   }
   check_lost(now);
+}
+
+void RobotServer::listen() {
+  dds_listener_t* l = dds_create_listener(&wake_);
+  // In Cyclone's receive thread: only the ring, which neither blocks nor allocates.
+  dds_lset_data_available(l, [](dds_entity_t, void* bell) {
+    rtc::detail::ring(*static_cast<rtc::detail::Doorbell*>(bell));
+  });
+  for (const Entity* r : {&request_reader_, &hb_reader_, &state_reader_, &frame_reader_}) {
+    const dds_return_t rc = dds_set_listener(r->get(), l);
+    if (rc < 0) {
+      dds_delete_listener(l);
+      check(rc, "a data-available listener");
+    }
+  }
+  dds_delete_listener(l);
+}
+
+std::int64_t RobotServer::next_wake() const noexcept {
+  const std::int64_t heartbeat = options_.net.heartbeat.count();
+  std::int64_t t = std::min(last_heartbeat_ns_ + heartbeat, next_loss_check_ns_);
+  for (const auto& l : locals_) {
+    if (l->have_slot) t = std::min(t, l->written_ns + heartbeat);
+  }
+  return t;
 }
 
 void RobotServer::read_heartbeats(std::int64_t now) {
@@ -789,6 +825,11 @@ void RobotServer::publish_states(std::int64_t now, bool last) {
 
 void RobotServer::check_lost(std::int64_t now) {
   const std::int64_t detection = options_.net.detection.count();
+  // The earliest moment one of the peers below may be found lost: the thread wakes then.
+  next_loss_check_ns_ = INT64_MAX;
+  const auto due = [&](std::int64_t seen) {
+    next_loss_check_ns_ = std::min(next_loss_check_ns_, seen + detection + 1);
+  };
   // Programs: an attached program silent for the detection time is lost.
   for (auto& lp : locals_) {
     Local& l = *lp;
@@ -798,7 +839,10 @@ void RobotServer::check_lost(std::int64_t now) {
         it != programs_.end() && it->second.instance == l.program_instance) {
       seen = std::max(seen, it->second.seen_ns);
     }
-    if (now - seen <= detection) continue;
+    if (now - seen <= detection) {
+      due(seen);
+      continue;
+    }
     const std::string why =
         fmt::format("the program {} was lost (no heartbeat for {:.0f} ms): stopped smoothly",
                     l.program, ms_of(now - seen));
@@ -812,7 +856,10 @@ void RobotServer::check_lost(std::int64_t now) {
   for (auto& [name, m] : mirrors_) {
     if (!m->has_state() || m->lost()) continue;
     const std::int64_t silent = now - m->received_ns();
-    if (silent <= detection) continue;
+    if (silent <= detection) {
+      due(m->received_ns());
+      continue;
+    }
     m->set_lost(true);
     const std::string lost =
         fmt::format("robot {} lost: its serve process {} is silent for {:.0f} ms", name,
@@ -827,7 +874,11 @@ void RobotServer::check_lost(std::int64_t now) {
     }
   }
   for (auto& [name, s] : streams_) {
-    if (s->lost || now - s->received_ns <= detection) continue;
+    if (s->lost) continue;
+    if (now - s->received_ns <= detection) {
+      due(s->received_ns);
+      continue;
+    }
     s->lost = true;
     for (auto& lp : locals_) {
       if (lp->streams.count(name) == 0) continue;

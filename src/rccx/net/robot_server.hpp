@@ -10,10 +10,13 @@
 //   serve.stop();                                     // halts smoothly, gives the claims back
 //
 // Threads: the cell's control task (never calls DDS: after each tick its cycle observer copies
-// each robot's setpoint into a triple buffer) and one middleware thread that polls every 1 ms:
-// it writes states (and each robot's ROS 2 joint state) and heartbeats, takes requests (all
-// Manipulator calls are made from it), answers them, publishes the motions' events, and stops the
-// robots of a lost program or of a lost leader smoothly (Manipulator::halt) saying why.
+// each robot's setpoint into a triple buffer and rings a doorbell) and one middleware thread,
+// woken by that doorbell, by data arriving (Cyclone listeners ring the same doorbell) or by its
+// next deadline (heartbeat, a peer's loss): it writes states (and each robot's ROS 2 joint state) and
+// heartbeats, takes requests
+// (all Manipulator calls are made from it), answers them at once, publishes the motions'
+// events, and stops the robots of a lost program or of a lost leader smoothly
+// (Manipulator::halt) saying why.
 #pragma once
 
 #include <atomic>
@@ -31,6 +34,7 @@
 #include "rccx/net/dds.hpp"
 #include "rccx/net/mirror.hpp"
 #include "rccx/rccl/transforms.hpp"
+#include "rccx/rtc/doorbell.hpp"
 
 namespace rccx::net {
 
@@ -111,6 +115,11 @@ class RobotServer {
   void publish_events();
   void publish_states(std::int64_t now, bool last = false);
   void check_lost(std::int64_t now);
+  /// When the middleware thread must run again with nothing arriving (steady ns): the next
+  /// heartbeat, a state to repeat, a peer's loss deadline.
+  [[nodiscard]] std::int64_t next_wake() const noexcept;
+  /// Cyclone's data-available listeners on the readers ring wake_ (from its receive thread).
+  void listen();
   /// Halts `l` smoothly; the events of its motions up to the last queued say `why`.
   void halt_with(Local& l, const std::string& why);
   void on_cycle() noexcept;
@@ -123,6 +132,10 @@ class RobotServer {
 
   std::string participant_name_;
   std::uint64_t instance_ = 0;
+  /// Rung by the control task after a tick, by Cyclone's listeners when data arrives, by
+  /// stop(); the middleware thread sleeps on it (a futex: the sample loop makes no DDS call,
+  /// takes no lock). Before the entities: it outlives their listeners.
+  rtc::detail::Doorbell wake_;
   std::unique_ptr<Participant> participant_;
   Entity hb_writer_, hb_reader_, claim_writer_, claim_reader_, state_writer_, state_reader_,
       request_reader_, ack_writer_, event_writer_, frame_reader_;
@@ -149,6 +162,7 @@ class RobotServer {
   bool stopped_ = false;
   std::int64_t last_heartbeat_ns_ = 0;
   std::uint64_t heartbeat_seq_ = 0;
+  std::int64_t next_loss_check_ns_ = INT64_MAX;  ///< steady: the earliest a peer may be lost
   mutable std::mutex failure_mutex_;
   std::string failure_;
 };
