@@ -549,7 +549,12 @@ int run_program(cell::Workcell& c, Watch& watch, const Options& o) {
   constexpr auto kTimeout = 60s;
   bool good = true;
   const auto wait = [&](rccl::Arm& m, const rccl::Event& e) {
-    good = good && reached(m.waitfor(e, kTimeout));
+    if (!good) return;
+    const rccl::WaitResult w = m.waitfor(e, kTimeout);
+    if (reached(w)) return;
+    good = false;  // failures() says why a motion failed; a timeout or lost control, here
+    fmt::print(stderr, "{}: waiting for motion {}: {}\n", &m == &puma ? "PUMA" : "Microbo", e.id,
+               rccl::to_string(w));
   };
   puma.set_velocity(80_mm, 45_deg);  // joint moves, too, take their time from these
   microbo.set_velocity(80_mm, 45_deg);
@@ -578,6 +583,9 @@ int run_program(cell::Workcell& c, Watch& watch, const Options& o) {
   puma.move(p_lift, grip);
   const rccl::Motion present = puma.move(p_present, grip);
   if (!good) {  // the pick failed: the Microbo's goals on the board would be nowhere
+    // Across processes a failure's event (with its reason) may come after the state that said
+    // the motion failed: a moment for it.
+    c.wait_for(500ms);
     for (rccl::Arm* m : {&puma, &microbo}) {
       for (const rccl::MotionEvent& f : m->failures()) {
         if (!f.message().empty())
@@ -696,6 +704,7 @@ int run_program(cell::Workcell& c, Watch& watch, const Options& o) {
   }
   if (!watch.note().empty()) fmt::print("({})\n", watch.note());
 
+  if (!good) c.wait_for(500ms);  // the failures' events, as above
   const std::size_t puma_failures = puma.failures().size();
   const std::size_t microbo_failures = microbo.failures().size();
   const std::optional<std::uint64_t> stops = watch.collision_stops();

@@ -10,14 +10,26 @@ foreach(var SCRIPT BUILD CSV PADS)
   endif()
 endforeach()
 
-file(REMOVE "${CSV}")
-# A loaded machine's stalls are not lost links here: the detection time is generous.
-execute_process(COMMAND "${SCRIPT}" --build "${BUILD}" --detection 500ms -- --csv "${CSV}"
-                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err TIMEOUT 400)
-message(STATUS "demo-distributed stdout:\n${out}")
-if(NOT err STREQUAL "")
-  message(STATUS "demo-distributed stderr:\n${err}")
-endif()
+# A loaded machine's stalls are not lost links here: the detection time is generous. One more
+# attempt, said, only when the first failed on a state that came late (a collision stop with
+# the allowance its age adds, or a peer silent past the detection time): real time on a shared
+# machine, not the program. Any other failure fails at once.
+foreach(attempt 1 2)
+  file(REMOVE "${CSV}")
+  execute_process(COMMAND "${SCRIPT}" --build "${BUILD}" --detection 250ms -- --csv "${CSV}"
+                  RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err TIMEOUT 400)
+  message(STATUS "demo-distributed (attempt ${attempt}) stdout:\n${out}")
+  if(NOT err STREQUAL "")
+    message(STATUS "demo-distributed (attempt ${attempt}) stderr:\n${err}")
+  endif()
+  if(rc STREQUAL "0" OR attempt EQUAL 2)
+    break()
+  endif()
+  if(NOT "${out}${err}" MATCHES "another process's, its state [0-9]+ ms old|is silent for [0-9]+ ms")
+    break()
+  endif()
+  message(STATUS "attempt 1 failed on a late state (above); once more")
+endforeach()
 if(NOT rc STREQUAL "0")
   message(FATAL_ERROR "demo-distributed exited with ${rc}")
 endif()
