@@ -40,6 +40,13 @@ demo-view: build-release
 demo-cell: build-release
 	$(RELEASE_DIR)/examples/10_circuit_board
 
+# The same demo as the thesis ran it, across processes (docs/NETWORK.md): the PUMA and the
+# Microbo each in a `rccx serve` process, the program in a third, over DDS on loopback, in real
+# time (about two minutes); the same table as demo-cell. scripts/demo-distributed --help.
+.PHONY: demo-distributed
+demo-distributed: build-release
+	scripts/demo-distributed --build $(RELEASE_DIR)
+
 # Debug build with AddressSanitizer and UndefinedBehaviorSanitizer, every test, then the
 # fuzz targets for FUZZ_SECONDS in all.
 test: unit-tests fuzz

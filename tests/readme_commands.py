@@ -57,6 +57,10 @@ TABLE = {
         Expect(0, r"^rccx serve: stopped; robots halted, claims given back"),
     "rccx certs init certs --participants puma,microbo,program":
         Expect(0, r"^program: certs/program/cert\.pem"),
+    # Two minutes of real time with two serve processes: ctest demo_distributed runs it (the
+    # script the target calls) and checks its table.
+    "make demo-distributed": Expect(0, r"^8 pads probed, \d+ on the moving board",
+                                    skip="ctest demo_distributed runs scripts/demo-distributed"),
     "make test": Expect(0, "", skip="it is what runs this test (ctest)"),
     "rccx kin robots": Expect(0, r"^puma560 - Unimation PUMA 560"),
     "rccx kin fk --robot puma560 0 0.7854 -3.1416 0 0.7854 0 --json":

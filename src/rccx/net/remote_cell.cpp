@@ -352,6 +352,7 @@ RemoteState RemoteArm::state() const {
   out.instance = s.instance;
   out.sample = s.sample;
   out.t_s = s.t_s;
+  out.stamp_ns = s.stamp_ns;
   out.q_commanded = kin::JointVector(std::min<std::size_t>(s.dof, 8));
   out.q_measured = kin::JointVector(std::min<std::size_t>(s.dof, 8));
   for (std::size_t j = 0; j < out.q_commanded.size(); ++j) {

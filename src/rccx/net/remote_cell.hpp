@@ -50,6 +50,7 @@ struct RemoteState {
   std::uint64_t instance = 0;
   std::uint64_t sample = 0;
   double t_s = 0.0;
+  std::int64_t stamp_ns = 0;     ///< CLOCK_REALTIME that t_s stands for (the serve's host clock)
   kin::JointVector q_commanded;  ///< rad / m
   kin::JointVector q_measured;
   cell::ToolSample tool;  ///< world <- T6 TOOL, commanded
