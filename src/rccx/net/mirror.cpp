@@ -49,6 +49,10 @@ rccl::TransformPtr remote_frame(std::string name, std::string reference,
 
 bool RobotMirror::apply(const rccx_net_RobotState& s, std::int64_t steady) noexcept {
   bool restarted = false;
+  // The last state of a serve process that has stopped (control ended) arriving while another
+  // instance serves the robot and is alive: stale, not a restart. Taken, it would clear the
+  // ledger and end the robot's control for the gates waiting on it.
+  if (s.instance != instance_ && instance_ != 0 && !lost() && s.control_ended) return false;
   if (s.instance != instance_) {
     restarted = instance_ != 0;
     instance_ = s.instance;
