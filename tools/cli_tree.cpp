@@ -15,10 +15,10 @@
 #include "db_command.hpp"
 #include "kin_command.hpp"
 #include "plot_command.hpp"
-#include "serve_command.hpp"
 #include "rccx/io/spelling.hpp"
 #include "rcu_command.hpp"
 #include "rtc_commands.hpp"
+#include "serve_command.hpp"
 #include "teach_command.hpp"
 #include "view_command.hpp"
 

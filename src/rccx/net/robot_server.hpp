@@ -12,11 +12,10 @@
 // Threads: the cell's control task (never calls DDS: after each tick its cycle observer copies
 // each robot's setpoint into a triple buffer and rings a doorbell) and one middleware thread,
 // woken by that doorbell, by data arriving (Cyclone listeners ring the same doorbell) or by its
-// next deadline (heartbeat, a peer's loss): it writes states (and each robot's ROS 2 joint state) and
-// heartbeats, takes requests
-// (all Manipulator calls are made from it), answers them at once, publishes the motions'
-// events, and stops the robots of a lost program or of a lost leader smoothly
-// (Manipulator::halt) saying why.
+// next deadline (heartbeat, a peer's loss): it writes states (and each robot's ROS 2 joint state)
+// and heartbeats, takes requests (all Manipulator calls are made from it), answers them at once,
+// publishes the motions' events, and stops the robots of a lost program or of a lost leader
+// smoothly (Manipulator::halt) saying why.
 #pragma once
 
 #include <atomic>
