@@ -60,6 +60,10 @@ struct DurationRow {
   std::string seconds;  ///< a value within its range, in seconds (bare)
 };
 
+/// rccx serve of the CVaRL cell's PUMA on loopback, its options to follow.
+const std::string kServe = "serve --cell " + std::string(RCCX_ROBOTS_DIR) +
+                           "/../cells/cvarl.json --robots puma --interface lo ";
+
 // Every duration option of every command: units everywhere, a bare number is seconds.
 const std::vector<DurationRow> kDurations = {
     {"report", "--seconds", "report --seconds {}", "0.2"},
@@ -77,6 +81,10 @@ const std::vector<DurationRow> kDurations = {
     {"cell-load", "--spin", "cell-load --robots 1 --seconds 0.05 --spin {}", "0.00001"},
     {"db", "--wait", "db --db /nonexistent/x.db --wait {} list", "0.2"},
     {"view", "--seconds", "view --robot puma560 --port 0 --fast --seconds {}", "0.2"},
+    // rccx serve on loopback, each row on a DDS domain no other test uses (45 .. 47).
+    {"serve", "--seconds", kServe + "--domain 45 --claim-wait 0.05 --seconds {}", "0.2"},
+    {"serve", "--detection", kServe + "--domain 46 --seconds 0.2 --detection {}", "0.1"},
+    {"serve", "--claim-wait", kServe + "--domain 47 --seconds 0.2 --claim-wait {}", "0.05"},
 };
 
 TEST(CliOptions, TheDurationTableNamesEveryDurationOption) {

@@ -401,16 +401,30 @@ TEST(NetServe, AKilledServeFailsTheProgramsWaitWithinTheDetectionTime) {
   EXPECT_TRUE(contains(why, "robot puma lost: its serve process " + holder + " is silent")) << why;
   EXPECT_THROW((void)puma.move(puma.park()), rccl::MotionError);
 
-  // A restarted serve is announced and the robot can be used again.
-  auto again = serve(d, "puma", "serve_again");
-  const auto until = std::chrono::steady_clock::now() + 15s;
-  while (std::chrono::steady_clock::now() < until && puma.state().participant == holder) {
-    std::this_thread::sleep_for(20ms);
+  // A restarted serve is announced and the robot can be used again. A serve of the Debug
+  // build may overrun its 7 ms period now and then (docs/NETWORK.md, the demonstration across
+  // processes), which ends its control: then once more with another serve, and said.
+  std::string before = holder;
+  for (int attempt = 1; attempt <= 2; ++attempt) {
+    auto again = serve(d, "puma", "serve_again");
+    const auto until = std::chrono::steady_clock::now() + 15s;
+    while (std::chrono::steady_clock::now() < until && puma.state().participant == before) {
+      std::this_thread::sleep_for(20ms);
+    }
+    std::this_thread::sleep_for(300ms);  // its request reader matched
+    const rccl::Motion back = puma.move(puma.park());
+    const rccl::WaitResult w = puma.waitfor(back.end(), 20s);
+    const std::string failed = failures_text(puma.failures());
+    if (w != rccl::WaitResult::reached && attempt == 1 && contains(failed, "control ended") &&
+        contains(again->err(), "control ended: a control cycle did not finish")) {
+      std::printf("the restarted serve overran its period (Debug build): once more\n");
+      before = puma.state().participant;
+      again->kill9();
+      continue;
+    }
+    EXPECT_EQ(w, rccl::WaitResult::reached) << failed << "\nserve: " << again->err();
+    break;
   }
-  std::this_thread::sleep_for(300ms);  // its request reader matched
-  const rccl::Motion back = puma.move(puma.park());
-  EXPECT_EQ(puma.waitfor(back.end(), 20s), rccl::WaitResult::reached)
-      << failures_text(puma.failures());
 }
 
 TEST(NetServe, AKilledProgramsRobotStopsSmoothlyAndTheServeSaysWhy) {

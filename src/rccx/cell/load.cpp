@@ -38,9 +38,15 @@ void start_circles(Cell& cell, const math::Vec3& centre_m) {
   constexpr double kRadius_m = 0.020;
   constexpr double kTurn_s = 5.0;
   cell.start();
-  // Every arm read once before the first move is checked against where it stands (in real
-  // time the first samples come a few periods after start; before them the arm reads zeros).
-  cell.wait_for(cell.model().base_period * 4);
+  // Every arm read once before the first move is checked against where it stands: in real
+  // time the first samples come a few periods after start, and before them the arm reads zeros.
+  for (int k = 0; k < 100; ++k) {
+    bool all_read = true;
+    for (const std::string& name : cell.robot_names())
+      all_read = all_read && cell.session(name).how().sample > 0;
+    if (all_read) break;
+    cell.wait_for(cell.model().base_period);
+  }
   const auto t6 = rccl::t6();
   // The wrist at centre_m (by default 450 mm out and 150 mm below the shoulder, example 05's
   // reach of the PUMA 560), pointing down and out; the circle in the base's x-y plane around it.

@@ -1,4 +1,5 @@
 #include "rccx/net/remote_cell.hpp"
+#include "rccx/net/middleware.hpp"
 
 #include <fmt/format.h>
 #include <pthread.h>
@@ -18,25 +19,10 @@ namespace rccx::net {
 namespace {
 
 using namespace std::chrono_literals;
-
-double ms_of(std::int64_t ns) {
-  return static_cast<double>(ns) * 1e-6;
-}
-
-std::uint64_t random_instance() {
-  std::random_device rd;
-  const std::uint64_t v = (static_cast<std::uint64_t>(rd()) << 32) ^ rd();
-  return v == 0 ? 1 : v;
-}
-
-template <class T>
-int take(dds_entity_t reader, std::vector<T>& buf, std::vector<void*>& ptrs,
-         std::vector<dds_sample_info_t>& info) {
-  for (std::size_t i = 0; i < buf.size(); ++i) ptrs[i] = &buf[i];
-  const dds_return_t n = dds_take(reader, ptrs.data(), info.data(), buf.size(),
-                                  static_cast<std::uint32_t>(buf.size()));
-  return n < 0 ? 0 : static_cast<int>(n);
-}
+using detail::ms_of;
+using detail::raise_priority;
+using detail::random_instance;
+using detail::take;
 
 rccl::MotionEvent to_event(const rccx_net_MotionEvent& e) {
   rccl::MotionEvent m;
@@ -64,16 +50,6 @@ std::string robots_of(const cell::CellModel& model) {
   std::string s;
   for (const auto& r : model.robots) s += (s.empty() ? "" : ", ") + r.name;
   return s;
-}
-
-/// The middleware thread decides that a peer is lost within the detection time, so it runs
-/// above ordinary threads when the process may (SCHED_FIFO at the lowest priority, below the
-/// control tasks'); otherwise as it is. It sleeps whenever nothing is pending, and each pass
-/// does a bounded amount of work, so it cannot starve others.
-void raise_priority() noexcept {
-  sched_param p{};
-  p.sched_priority = sched_get_priority_min(SCHED_FIFO);
-  (void)pthread_setschedparam(pthread_self(), SCHED_FIFO, &p);
 }
 
 }  // namespace

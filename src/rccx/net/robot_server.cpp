@@ -1,4 +1,5 @@
 #include "rccx/net/robot_server.hpp"
+#include "rccx/net/middleware.hpp"
 
 #include <fmt/format.h>
 #include <pthread.h>
@@ -22,6 +23,10 @@ namespace rccx::net {
 namespace {
 
 using namespace std::chrono_literals;
+using detail::ms_of;
+using detail::raise_priority;
+using detail::random_instance;
+using detail::take;
 
 /// What the control task hands the middleware thread after a tick (trivially copyable).
 struct Slot {
@@ -35,41 +40,10 @@ struct Slot {
   std::int64_t stamp_ns = 0;
 };
 
-std::uint64_t random_instance() {
-  std::random_device rd;
-  const std::uint64_t v = (static_cast<std::uint64_t>(rd()) << 32) ^ rd();
-  return v == 0 ? 1 : v;
-}
-
-double ms_of(std::int64_t ns) {
-  return static_cast<double>(ns) * 1e-6;
-}
-
 std::string join(const std::vector<std::string>& v) {
   std::string s;
   for (const auto& x : v) s += (s.empty() ? "" : ", ") + x;
   return s;
-}
-
-/// Takes up to `n` samples of `reader` into `buf`; returns how many are valid data, in
-/// `info` order (invalid ones: instance state changes).
-template <class T>
-int take(dds_entity_t reader, std::vector<T>& buf, std::vector<void*>& ptrs,
-         std::vector<dds_sample_info_t>& info) {
-  for (std::size_t i = 0; i < buf.size(); ++i) ptrs[i] = &buf[i];
-  const dds_return_t n = dds_take(reader, ptrs.data(), info.data(), buf.size(),
-                                  static_cast<std::uint32_t>(buf.size()));
-  return n < 0 ? 0 : static_cast<int>(n);
-}
-
-/// The middleware thread decides that a peer is lost within the detection time, so it runs
-/// above ordinary threads when the process may (SCHED_FIFO at the lowest priority, below the
-/// control tasks'); otherwise as it is. It sleeps whenever nothing is pending, and each pass
-/// does a bounded amount of work, so it cannot starve others.
-void raise_priority() noexcept {
-  sched_param p{};
-  p.sched_priority = sched_get_priority_min(SCHED_FIFO);
-  (void)pthread_setschedparam(pthread_self(), SCHED_FIFO, &p);
 }
 
 }  // namespace
