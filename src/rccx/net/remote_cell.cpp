@@ -649,7 +649,9 @@ void RemoteCell::poll(std::int64_t now) {
           a->mirror_->set_lost(false);
         }
         // Control ended on the serve (an overrun, a fault): the waits that now fail say why.
-        if (restarted) a->end_said_ = false;
+        // A new serve, or control running again (restarted after an overrun): a later end is
+        // a new failure.
+        if (restarted || buf[i].terminate_code == 0) a->end_said_ = false;
         if (buf[i].terminate_code != 0 && !a->end_said_) {
           a->end_said_ = true;
           const std::string why = fmt::format("robot {}'s control ended on its serve process: {}",

@@ -63,6 +63,7 @@ struct RobotServer::Local {
   bool have_slot = false;
   std::int64_t written_ns = 0;  ///< steady, last state written
   bool end_said = false;        ///< its control's end was said on stderr
+  std::uint64_t restarts = 0;   ///< control restarted after overruns
   std::string program;          ///< attached program ("" none)
   std::uint64_t program_instance = 0;
   std::int64_t attached_ns = 0;
@@ -394,6 +395,7 @@ void RobotServer::poll() {
   read_requests(now);
   publish_events();
   publish_states(now);
+  restart_after_overruns();
   if (now - last_heartbeat_ns_ >= options_.net.heartbeat.count()) {
     rccx_net_Heartbeat hb{};
     copy_to(hb.participant, participant_name_);
@@ -407,6 +409,29 @@ void RobotServer::poll() {
     last_heartbeat_ns_ = now;
   }
   check_lost(now);
+}
+
+void RobotServer::restart_after_overruns() {
+  if (stop_.load()) return;
+  for (auto& lp : locals_) {
+    Local& l = *lp;
+    // Said and published first (publish_states), so the program's waits fail with the reason.
+    if (!l.end_said || l.session->ended_code() != rtc::TerminateCode::overrun) continue;
+    // A missed deadline ended control (RTC's rule); the arm holds where it was. A serve runs
+    // on: control starts again at rest where the arm stands, as `rccx report` does.
+    try {
+      l.session->release();
+      l.arm->start();
+      l.end_said = false;
+      ++l.restarts;
+      io::eprint("rccx serve: robot {}: control restarted at rest after the overrun (restart {})\n",
+                 l.name, l.restarts);
+    } catch (const std::exception& e) {
+      io::eprint("rccx serve: robot {}: control could not restart after the overrun: {}\n", l.name,
+                 e.what());
+      l.end_said = true;
+    }
+  }
 }
 
 void RobotServer::listen() {

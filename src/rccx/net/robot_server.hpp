@@ -112,6 +112,8 @@ class RobotServer {
   void handle(const rccx_net_MotionRequest& r, std::int64_t now);
   void execute(Local& l, const rccx_net_MotionRequest& r, rccx_net_MotionAck& ack);
   void publish_events();
+  /// A robot whose control an overrun ended (said and published already) starts again at rest.
+  void restart_after_overruns();
   void publish_states(std::int64_t now, bool last = false);
   void check_lost(std::int64_t now);
   /// When the middleware thread must run again with nothing arriving (steady ns): the next
