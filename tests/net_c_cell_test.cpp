@@ -20,6 +20,8 @@
 #include <thread>
 #include <vector>
 
+#include "net_serve_helpers.hpp"
+
 extern char** environ;
 
 using namespace std::chrono_literals;
@@ -34,88 +36,11 @@ std::uint32_t domain() {
   return 60 + static_cast<std::uint32_t>(getpid() % 40);
 }
 
-std::string read_file(const std::string& path) {
-  std::ifstream f(path);
-  std::stringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
-
-/// A child process with `env` added to this one's environment, its output in files; killed at
-/// the end if still running.
-class Child {
- public:
-  Child(const std::vector<std::string>& args, const std::vector<std::string>& env,
-        const std::string& tag) {
-    out_ = ::testing::TempDir() + "rccx_c_" + tag + "_" + std::to_string(getpid()) + ".out";
-    err_ = ::testing::TempDir() + "rccx_c_" + tag + "_" + std::to_string(getpid()) + ".err";
-    posix_spawn_file_actions_t fa;
-    posix_spawn_file_actions_init(&fa);
-    posix_spawn_file_actions_addopen(&fa, 1, out_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    posix_spawn_file_actions_addopen(&fa, 2, err_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    std::vector<char*> argv;
-    for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-    argv.push_back(nullptr);
-    std::vector<std::string> all = env;
-    for (char** e = environ; *e != nullptr; ++e) {
-      const std::string kv(*e);
-      bool given = false;
-      for (const auto& g : env)
-        given = given || kv.substr(0, kv.find('=')) == g.substr(0, g.find('='));
-      if (!given) all.push_back(kv);
-    }
-    std::vector<char*> envp;
-    for (auto& kv : all) envp.push_back(kv.data());
-    envp.push_back(nullptr);
-    env_ = std::move(all);
-    if (posix_spawn(&pid_, argv[0], &fa, nullptr, argv.data(), envp.data()) != 0) pid_ = -1;
-    posix_spawn_file_actions_destroy(&fa);
-  }
-  ~Child() {
-    if (pid_ <= 0 || exited_) return;
-    kill(pid_, SIGTERM);
-    if (wait_exit(5s) == -1) {
-      kill(pid_, SIGKILL);
-      (void)wait_exit(5s);
-    }
-  }
-  Child(const Child&) = delete;
-  Child& operator=(const Child&) = delete;
-
-  [[nodiscard]] bool started() const { return pid_ > 0; }
-  /// The exit code, 128 + signal, or -1 when still running after `timeout`.
-  int wait_exit(std::chrono::nanoseconds timeout) {
-    if (exited_) return code_;
-    const auto until = std::chrono::steady_clock::now() + timeout;
-    while (std::chrono::steady_clock::now() < until) {
-      int status = 0;
-      if (waitpid(pid_, &status, WNOHANG) == pid_) {
-        exited_ = true;
-        code_ = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-        return code_;
-      }
-      std::this_thread::sleep_for(10ms);
-    }
-    return -1;
-  }
-  [[nodiscard]] std::string out() const { return read_file(out_); }
-  [[nodiscard]] std::string err() const { return read_file(err_); }
-
- private:
-  pid_t pid_ = -1;
-  std::string out_, err_;
-  std::vector<std::string> env_;
-  bool exited_ = false;
-  int code_ = -1;
-};
+using rccx::test::Child;
 
 std::unique_ptr<Child> serve(std::uint32_t d, const std::string& robots) {
-  return std::make_unique<Child>(
-      std::vector<std::string>{RCCX_EXE, "serve", "--cell", kCell, "--robots", robots, "--domain",
-                               std::to_string(d), "--interface", "lo", "--detection",
-                               std::to_string(kDetectionMs) + "ms", "--claim-wait", "200ms",
-                               "--seconds", "120"},
-      std::vector<std::string>{}, "serve_" + robots);
+  return rccx::test::spawn_serve(kCell, d, robots, "c_serve_" + robots,
+                                 std::chrono::milliseconds(kDetectionMs));
 }
 
 struct Printed {
@@ -144,7 +69,7 @@ std::string both(const Child& c) {
 
 TEST(NetCCell, TheSameCProgramRunsInOneProcessAndAcrossTwoServeProcesses) {
   // One process: the cell as always (simulated time), no switch.
-  Child local({C_CELL_REMOTE, "together"}, {"RCCX_CELL=" + kCell, "RCCX_CELL_REMOTE=0"}, "local");
+  Child local({C_CELL_REMOTE, "together"}, "c_local", {"RCCX_CELL=" + kCell, "RCCX_CELL_REMOTE=0"});
   ASSERT_TRUE(local.started());
   ASSERT_EQ(local.wait_exit(120s), 0) << both(local);
 
@@ -152,10 +77,9 @@ TEST(NetCCell, TheSameCProgramRunsInOneProcessAndAcrossTwoServeProcesses) {
   auto puma = serve(d, "puma");
   auto microbo = serve(d, "microbo");
   ASSERT_TRUE(puma->started() && microbo->started());
-  Child remote({C_CELL_REMOTE, "together"},
+  Child remote({C_CELL_REMOTE, "together"}, "c_remote",
                {"RCCX_CELL=" + kCell, "RCCX_CELL_REMOTE=1", "RCCX_DOMAIN=" + std::to_string(d),
-                "RCCX_DDS_INTERFACE=lo", "RCCX_DETECTION_MS=" + std::to_string(kDetectionMs)},
-               "remote");
+                "RCCX_DDS_INTERFACE=lo", "RCCX_DETECTION_MS=" + std::to_string(kDetectionMs)});
   ASSERT_TRUE(remote.started());
   const int code = remote.wait_exit(120s);
   if (code != 0 && remote.err().find("with overrun (10)") != std::string::npos) {
@@ -210,10 +134,9 @@ TEST(NetCCell, TheSameCProgramRunsInOneProcessAndAcrossTwoServeProcesses) {
 }
 
 TEST(NetCCell, WithoutServeProcessesTheOpenFailsWithTheServeCommandToStart) {
-  Child remote({C_CELL_REMOTE},
+  Child remote({C_CELL_REMOTE}, "c_none",
                {"RCCX_CELL=" + kCell, "RCCX_CELL_REMOTE=1",
-                "RCCX_DOMAIN=" + std::to_string(domain() + 40), "RCCX_DDS_INTERFACE=lo"},
-               "none");
+                "RCCX_DOMAIN=" + std::to_string(domain() + 40), "RCCX_DDS_INTERFACE=lo"});
   ASSERT_TRUE(remote.started());
   ASSERT_EQ(remote.wait_exit(60s), 1) << both(remote);
   EXPECT_NE(remote.out().find("open: RTC_E_OPEN"), std::string::npos) << both(remote);
@@ -221,7 +144,7 @@ TEST(NetCCell, WithoutServeProcessesTheOpenFailsWithTheServeCommandToStart) {
 }
 
 TEST(NetCCell, ABadSwitchValueIsRefusedAndSaysWhatItTakes) {
-  Child c({C_CELL_REMOTE}, {"RCCX_CELL=" + kCell, "RCCX_CELL_REMOTE=yes"}, "badswitch");
+  Child c({C_CELL_REMOTE}, "c_badswitch", {"RCCX_CELL=" + kCell, "RCCX_CELL_REMOTE=yes"});
   ASSERT_TRUE(c.started());
   ASSERT_EQ(c.wait_exit(60s), 1) << both(c);
   EXPECT_NE(c.out().find("open: RTC_E_ARGUMENT"), std::string::npos) << both(c);

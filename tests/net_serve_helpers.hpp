@@ -1,6 +1,7 @@
 // What the tests of `rccx serve` processes share (net_same_path_test, net_serve_ros2_test): a
 // child process killed at the end, a serve spawned from the rccx executable on loopback, and a
-// recorder of every RobotState of a domain. (net_serve_test.cpp has its own copies.)
+// recorder of every RobotState of a domain. (net_serve_test.cpp uses the child and the serve;
+// its own recorder keeps the fields its tests compare.)
 #pragma once
 
 #include <fcntl.h>
@@ -56,7 +57,9 @@ inline net::NetOptions loopback(
 /// SIGTERM, then SIGKILL, at the end if still running.
 class Child {
  public:
-  Child(const std::vector<std::string>& args, const std::string& tag) {
+  /// `env` ("NAME=value") is added to this process's environment, replacing the same names.
+  Child(const std::vector<std::string>& args, const std::string& tag,
+        const std::vector<std::string>& env = {}) {
     const std::string base =
         std::string(P_tmpdir) + "/rccx_" + tag + "_" + std::to_string(getpid());
     out_ = base + ".out";
@@ -68,7 +71,18 @@ class Child {
     std::vector<char*> argv;
     for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
     argv.push_back(nullptr);
-    if (posix_spawn(&pid_, argv[0], &fa, nullptr, argv.data(), environ) != 0) pid_ = -1;
+    std::vector<std::string> all = env;
+    for (char** e = environ; *e != nullptr; ++e) {
+      const std::string kv(*e);
+      bool given = false;
+      for (const auto& g : env)
+        given = given || kv.substr(0, kv.find('=')) == g.substr(0, g.find('='));
+      if (!given) all.push_back(kv);
+    }
+    std::vector<char*> envp;
+    for (auto& kv : all) envp.push_back(kv.data());
+    envp.push_back(nullptr);
+    if (posix_spawn(&pid_, argv[0], &fa, nullptr, argv.data(), envp.data()) != 0) pid_ = -1;
     posix_spawn_file_actions_destroy(&fa);
   }
   ~Child() {
@@ -83,6 +97,12 @@ class Child {
   Child& operator=(const Child&) = delete;
 
   [[nodiscard]] pid_t pid() const { return pid_; }
+  [[nodiscard]] bool started() const { return pid_ > 0; }
+  /// kill -9, and reaped.
+  void kill9() {
+    kill(pid_, SIGKILL);
+    (void)wait_exit(std::chrono::seconds(5));
+  }
   /// The exit code, 128 + signal, or -1 when still running after `timeout`.
   int wait_exit(std::chrono::nanoseconds timeout) {
     if (exited_) return code_;

@@ -21,6 +21,7 @@
 #include <thread>
 #include <vector>
 
+#include "net_serve_helpers.hpp"
 #include "rccx/cell/cell.hpp"
 #include "rccx/cell/cell_model.hpp"
 #include "rccx/net/codec.hpp"
@@ -45,101 +46,15 @@ std::uint32_t domain(int k = 0) {
   return 140 + static_cast<std::uint32_t>(getpid() % 40) * 2 + static_cast<std::uint32_t>(k);
 }
 
+using test::Child;
+using test::now_ns;
+
 net::NetOptions loopback(std::uint32_t d) {
-  net::NetOptions o;
-  o.domain = d;
-  o.interface = "lo";
-  o.detection = std::chrono::milliseconds(kDetectionMs);
-  o.heartbeat = o.detection / 4;
-  return o;
+  return test::loopback(d, std::chrono::milliseconds(kDetectionMs));
 }
-
-std::int64_t now_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(
-             std::chrono::steady_clock::now().time_since_epoch())
-      .count();
-}
-
-std::string read_file(const std::string& path) {
-  std::ifstream f(path);
-  std::stringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
-
-/// A child process, its stdout and stderr in files; killed at the end if still running.
-class Child {
- public:
-  Child(const std::vector<std::string>& args, const std::string& tag) {
-    out_ = ::testing::TempDir() + "rccx_" + tag + "_" + std::to_string(getpid()) + ".out";
-    err_ = ::testing::TempDir() + "rccx_" + tag + "_" + std::to_string(getpid()) + ".err";
-    posix_spawn_file_actions_t fa;
-    posix_spawn_file_actions_init(&fa);
-    posix_spawn_file_actions_addopen(&fa, 1, out_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    posix_spawn_file_actions_addopen(&fa, 2, err_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    std::vector<char*> argv;
-    for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-    argv.push_back(nullptr);
-    if (posix_spawn(&pid_, argv[0], &fa, nullptr, argv.data(), environ) != 0) pid_ = -1;
-    posix_spawn_file_actions_destroy(&fa);
-  }
-  ~Child() {
-    if (pid_ <= 0 || exited_) return;
-    kill(pid_, SIGTERM);
-    if (wait_exit(5s) == -1) {
-      kill(pid_, SIGKILL);
-      (void)wait_exit(5s);
-    }
-  }
-  Child(const Child&) = delete;
-  Child& operator=(const Child&) = delete;
-
-  [[nodiscard]] pid_t pid() const { return pid_; }
-  void kill9() {
-    kill(pid_, SIGKILL);
-    (void)wait_exit(5s);
-  }
-  /// The exit code, 128 + signal, or -1 when still running after `timeout`.
-  int wait_exit(std::chrono::nanoseconds timeout) {
-    if (exited_) return code_;
-    const auto until = std::chrono::steady_clock::now() + timeout;
-    while (std::chrono::steady_clock::now() < until) {
-      int status = 0;
-      if (waitpid(pid_, &status, WNOHANG) == pid_) {
-        exited_ = true;
-        code_ = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-        return code_;
-      }
-      std::this_thread::sleep_for(5ms);
-    }
-    return -1;
-  }
-  [[nodiscard]] std::string out() const { return read_file(out_); }
-  [[nodiscard]] std::string err() const { return read_file(err_); }
-  /// Waits until stdout holds `text` (or the child ended, or timeout).
-  bool wait_out(const std::string& text, std::chrono::nanoseconds timeout) {
-    const auto until = std::chrono::steady_clock::now() + timeout;
-    while (std::chrono::steady_clock::now() < until) {
-      if (out().find(text) != std::string::npos) return true;
-      std::this_thread::sleep_for(10ms);
-    }
-    return false;
-  }
-
- private:
-  pid_t pid_ = -1;
-  std::string out_, err_;
-  bool exited_ = false;
-  int code_ = -1;
-};
 
 std::unique_ptr<Child> serve(std::uint32_t d, const std::string& robots, const std::string& tag) {
-  return std::make_unique<Child>(
-      std::vector<std::string>{RCCX_EXE, "serve", "--cell", kCell, "--robots", robots, "--domain",
-                               std::to_string(d), "--interface", "lo", "--detection",
-                               std::to_string(kDetectionMs) + "ms", "--claim-wait", "200ms",
-                               "--seconds", "120"},
-      tag);
+  return test::spawn_serve(kCell, d, robots, tag, std::chrono::milliseconds(kDetectionMs));
 }
 
 /// Every RobotState sample of the domain, one record per (robot, sample).
