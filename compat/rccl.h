@@ -561,7 +561,9 @@ int rccl_cell_open(const char* cell_file);
  * RCCX_CELL_REMOTE=1 (rccl_cell_open then joins them: a program does not change) or the program
  * calls rccl_cell_open_remote. The DDS domain is `domain` (-1: $RCCX_DOMAIN, else 0), the
  * network interface $RCCX_DDS_INTERFACE ("lo" on one machine), the time after which a silent
- * serve process counts as lost $RCCX_DETECTION_MS (default 20). Every robot of the cell file
+ * serve process counts as lost $RCCX_DETECTION_MS (default 20); with $RCCX_SECURE_DIR (the
+ * directory of `rccx certs init`) the program joins with DDS Security as the participant
+ * $RCCX_SECURE_IDENTITY (default "program"). Every robot of the cell file
  * must be served (RTC_E_OPEN after 10 s otherwise, naming the robot and the serve command).
  * What cannot cross processes is refused with its reason: rccl_together (RTC_E_NOT_YET), a
  * position with a C function's transform (RTC_E_UNREACHABLE at mnp_move). mnp_tool_frame's

@@ -128,10 +128,16 @@ T* member_of(const MANIP* m, const char* call, T* rccl_manip::*member) {
 }
 
 /// The network options of a remote cell: the domain given (< 0: $RCCX_DOMAIN, else 0), the
-/// interface from $RCCX_DDS_INTERFACE, the detection time from $RCCX_DETECTION_MS.
+/// interface from $RCCX_DDS_INTERFACE, the detection time from $RCCX_DETECTION_MS, DDS Security
+/// from $RCCX_SECURE_DIR (`rccx certs init`'s directory) as $RCCX_SECURE_IDENTITY ("program").
 rccx::net::NetOptions remote_options(int domain) {
   rccx::net::NetOptions o;
   if (domain >= 0) o.domain = static_cast<std::uint32_t>(domain);
+  if (const char* env = std::getenv("RCCX_SECURE_DIR"); env != nullptr && *env != '\0') {
+    o.secure_dir = env;
+    const char* id = std::getenv("RCCX_SECURE_IDENTITY");
+    o.secure_identity = id != nullptr && *id != '\0' ? id : "program";
+  }
   if (const char* env = std::getenv("RCCX_DETECTION_MS"); env != nullptr && *env != '\0') {
     o.detection = std::chrono::milliseconds(
         rccx::io::parse_integer(env, "RCCX_DETECTION_MS (ms, 1 .. 10000)", 1, 10000));

@@ -12,6 +12,7 @@
 
 #include <chrono>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <memory>
 #include <regex>
@@ -141,6 +142,60 @@ TEST(NetCCell, WithoutServeProcessesTheOpenFailsWithTheServeCommandToStart) {
   ASSERT_EQ(remote.wait_exit(60s), 1) << both(remote);
   EXPECT_NE(remote.out().find("open: RTC_E_OPEN"), std::string::npos) << both(remote);
   EXPECT_NE(remote.err().find("rccx serve --cell"), std::string::npos) << both(remote);
+}
+
+/// Serve processes secured with `rccx certs init`'s files: the C program joins them only with
+/// RCCX_SECURE_DIR (as participant "program"); without it, it sees no robot and cannot open.
+TEST(NetCCell, WithSecuredServesOnlyAProgramGivenRccxSecureDirJoinsThem) {
+  const std::string dir = ::testing::TempDir() + "rccx_c_certs_" + std::to_string(getpid());
+  Child certs({RCCX_EXE, "certs", "init", dir, "--participants", "puma,microbo,program"},
+              "c_certs");
+  ASSERT_TRUE(certs.started());
+  ASSERT_EQ(certs.wait_exit(120s), 0) << both(certs);
+  struct Removed {
+    std::string path;
+    ~Removed() { std::filesystem::remove_all(path); }
+  } removed{dir};
+  const std::uint32_t d = domain() + 120;  // 180 .. 219: secure domains end at 230
+  auto puma = rccx::test::spawn_serve(kCell, d, "puma", "c_secure_puma",
+                                      std::chrono::milliseconds(kDetectionMs),
+                                      {"--secure", dir, "--identity", "puma"});
+  auto microbo = rccx::test::spawn_serve(kCell, d, "microbo", "c_secure_microbo",
+                                         std::chrono::milliseconds(kDetectionMs),
+                                         {"--secure", dir, "--identity", "microbo"});
+  ASSERT_TRUE(puma->started() && microbo->started());
+  const std::vector<std::string> env{
+      "RCCX_CELL=" + kCell, "RCCX_CELL_REMOTE=1", "RCCX_DOMAIN=" + std::to_string(d),
+      "RCCX_DDS_INTERFACE=lo", "RCCX_DETECTION_MS=" + std::to_string(kDetectionMs)};
+
+  Child plain({C_CELL_REMOTE}, "c_plain", env);
+  ASSERT_TRUE(plain.started());
+  ASSERT_EQ(plain.wait_exit(60s), 1) << both(plain);
+  EXPECT_NE(plain.out().find("open: RTC_E_OPEN"), std::string::npos) << both(plain);
+
+  std::vector<std::string> secure_env = env;
+  secure_env.push_back("RCCX_SECURE_DIR=" + dir);
+  Child secure({C_CELL_REMOTE}, "c_secure", secure_env);
+  ASSERT_TRUE(secure.started());
+  const int code = secure.wait_exit(120s);
+  if (code != 0 && secure.err().find("with overrun (10)") != std::string::npos) {
+    GTEST_SKIP() << "a serve process overran its real-time period (machine too loaded):\n"
+                 << secure.err();
+  }
+  ASSERT_EQ(code, 0) << both(secure) << "\npuma serve:\n" << puma->err();
+  EXPECT_NE(secure.out().find("open: RTC_OK"), std::string::npos) << both(secure);
+  EXPECT_EQ(parse(secure.out()).times_ms.size(), 3U) << secure.out();
+}
+
+TEST(NetCCell, ABadSecureDirIsRefusedNamingIt) {
+  Child c({C_CELL_REMOTE}, "c_badsecure",
+          {"RCCX_CELL=" + kCell, "RCCX_CELL_REMOTE=1",
+           "RCCX_DOMAIN=" + std::to_string(domain() + 80), "RCCX_DDS_INTERFACE=lo",
+           "RCCX_SECURE_DIR=/nonexistent/rccx-certs"});
+  ASSERT_TRUE(c.started());
+  ASSERT_EQ(c.wait_exit(60s), 1) << both(c);
+  EXPECT_NE(c.out().find("open: RTC_E_OPEN"), std::string::npos) << both(c);
+  EXPECT_NE(c.err().find("/nonexistent/rccx-certs"), std::string::npos) << both(c);
 }
 
 TEST(NetCCell, ABadSwitchValueIsRefusedAndSaysWhatItTakes) {

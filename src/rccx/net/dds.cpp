@@ -60,7 +60,11 @@ dds_duration_t to_dds(std::chrono::nanoseconds d) {
 std::string domain_config(const std::string& interface) {
   if (interface.empty()) return {};
   std::string peers;
+  // Multicast "false" on loopback rather than "default": Cyclone would find it has none and say
+  // so on stderr in every process.
+  std::string multicast = "default";
   if (interface == "lo" || interface == "127.0.0.1") {
+    multicast = "false";
     peers =
         "<Discovery><ParticipantIndex>auto</ParticipantIndex>"
         "<MaxAutoParticipantIndex>40</MaxAutoParticipantIndex>"
@@ -68,8 +72,8 @@ std::string domain_config(const std::string& interface) {
   }
   return fmt::format(
       "<CycloneDDS><Domain id=\"any\"><General><Interfaces><NetworkInterface name=\"{}\" "
-      "multicast=\"default\"/></Interfaces></General>{}</Domain></CycloneDDS>",
-      interface, peers);
+      "multicast=\"{}\"/></Interfaces></General>{}</Domain></CycloneDDS>",
+      interface, multicast, peers);
 }
 
 }  // namespace
