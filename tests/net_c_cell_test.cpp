@@ -164,9 +164,9 @@ TEST(NetCCell, WithSecuredServesOnlyAProgramGivenRccxSecureDirJoinsThem) {
                                          std::chrono::milliseconds(kDetectionMs),
                                          {"--secure", dir, "--identity", "microbo"});
   ASSERT_TRUE(puma->started() && microbo->started());
-  const std::vector<std::string> env{
-      "RCCX_CELL=" + kCell, "RCCX_CELL_REMOTE=1", "RCCX_DOMAIN=" + std::to_string(d),
-      "RCCX_DDS_INTERFACE=lo", "RCCX_DETECTION_MS=" + std::to_string(kDetectionMs)};
+  const std::vector<std::string> env{"RCCX_CELL=" + kCell, "RCCX_CELL_REMOTE=1",
+                                     "RCCX_DOMAIN=" + std::to_string(d), "RCCX_DDS_INTERFACE=lo",
+                                     "RCCX_DETECTION_MS=" + std::to_string(kDetectionMs)};
 
   Child plain({C_CELL_REMOTE}, "c_plain", env);
   ASSERT_TRUE(plain.started());
@@ -188,10 +188,10 @@ TEST(NetCCell, WithSecuredServesOnlyAProgramGivenRccxSecureDirJoinsThem) {
 }
 
 TEST(NetCCell, ABadSecureDirIsRefusedNamingIt) {
-  Child c({C_CELL_REMOTE}, "c_badsecure",
-          {"RCCX_CELL=" + kCell, "RCCX_CELL_REMOTE=1",
-           "RCCX_DOMAIN=" + std::to_string(domain() + 80), "RCCX_DDS_INTERFACE=lo",
-           "RCCX_SECURE_DIR=/nonexistent/rccx-certs"});
+  Child c(
+      {C_CELL_REMOTE}, "c_badsecure",
+      {"RCCX_CELL=" + kCell, "RCCX_CELL_REMOTE=1", "RCCX_DOMAIN=" + std::to_string(domain() + 80),
+       "RCCX_DDS_INTERFACE=lo", "RCCX_SECURE_DIR=/nonexistent/rccx-certs"});
   ASSERT_TRUE(c.started());
   ASSERT_EQ(c.wait_exit(60s), 1) << both(c);
   EXPECT_NE(c.out().find("open: RTC_E_OPEN"), std::string::npos) << both(c);
