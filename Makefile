@@ -87,10 +87,10 @@ bench-cell: build-release
 
 # The network layer on loopback (docs/NETWORK.md "Benchmark"): Cyclone's ddsperf ping/pong and
 # rccx's request round trip, state latency and robots at 1 kHz (bench/net_bench.cpp), one JSON
-# document (also bench-results/net.json); about a minute. Builds only the benchmark's target.
+# document (also bench-results/net.json); about 15 minutes. Builds the benchmark and rccx (its serve).
 .PHONY: bench-net
 bench-net: deps $(RELEASE_DIR)/CMakeCache.txt
-	$(CMAKE) --build $(RELEASE_DIR) -j$(JOBS) --target rccx_net_bench
+	$(CMAKE) --build $(RELEASE_DIR) -j$(JOBS) --target rccx_net_bench rccx
 	@mkdir -p bench-results
 	scripts/bench-net --build $(RELEASE_DIR) --out bench-results/net.json
 

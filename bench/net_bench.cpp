@@ -28,6 +28,9 @@
 // Environment: RCCX_BENCH_DOMAIN (else 150 + pid % 50), RCCX_BENCH_FLEET_SECONDS (3),
 // RCCX_BENCH_ROUNDTRIPS (100000), RCCX_BENCH_STATE_SAMPLES (100000), RCCX_BENCH_RCCX and
 // RCCX_BENCH_CELL (the rccx executable and a cell file: the Serve cases skip without them),
+// RCCX_BENCH_STATE_CELL (the cell file of BM_ServeStateOneWay, else RCCX_BENCH_CELL: the script
+// gives it one with a 1 ms period, the round trips the cell as shipped),
+// RCCX_BENCH_READER_DEPTH (the fleet reader's keep-last depth, 1: see fleet_reader),
 // RCCX_BENCH_SECURE_DIR (DDS Security's files of rccx certs init, identities "program" here and
 // "puma" in the child and the serve).
 // Diagnoses: RCCX_BENCH_LISTENER=1 (the responder answers from a listener, in Cyclone's receive
@@ -311,7 +314,8 @@ int run_state_writer(std::uint32_t domain, long count, long rate_hz) {
 /// robots instead of one each.
 std::string batched_loopback_config() {
   return "<CycloneDDS><Domain id=\"any\"><General><Interfaces><NetworkInterface name=\"lo\" "
-         "multicast=\"default\"/></Interfaces></General><Discovery><ParticipantIndex>auto"
+         "multicast=\"default\"/></Interfaces><AllowMulticast>false</AllowMulticast></"
+         "General><Discovery><ParticipantIndex>auto"
          "</ParticipantIndex><MaxAutoParticipantIndex>40</MaxAutoParticipantIndex><Peers><Peer "
          "address=\"127.0.0.1\"/></Peers></Discovery><Internal><WriteBatch>true</WriteBatch>"
          "</Internal></Domain></CycloneDDS>";
@@ -480,9 +484,11 @@ BENCHMARK(BM_NetStateOneWay)->Iterations(1)->Unit(benchmark::kMillisecond)->UseR
 /// `rccx serve` of `robots` (RCCX_BENCH_RCCX: the rccx executable; RCCX_BENCH_CELL: its cell
 /// file), secured as "puma" when RCCX_BENCH_SECURE_DIR is set; nullptr (the case skips) when
 /// either is unset.
-std::unique_ptr<Child> start_serve(std::uint32_t domain, const char* robots) {
+std::unique_ptr<Child> start_serve(std::uint32_t domain, const char* robots,
+                                   const char* cell_variable = "RCCX_BENCH_CELL") {
   const char* rccx_exe = std::getenv("RCCX_BENCH_RCCX");
-  const char* cell = std::getenv("RCCX_BENCH_CELL");
+  const char* cell = std::getenv(cell_variable);
+  if (cell == nullptr || *cell == '\0') cell = std::getenv("RCCX_BENCH_CELL");
   if (rccx_exe == nullptr || cell == nullptr || *rccx_exe == '\0' || *cell == '\0') return nullptr;
   std::vector<std::string> argv{rccx_exe,      "serve", "--cell",       cell,
                                 "--robots",    robots,  "--domain",     std::to_string(domain),
@@ -625,7 +631,7 @@ void BM_ServeStateOneWay(benchmark::State& state) {
     const net::Participant p(options(domain, "program"));
     const net::Entity states = p.reader(net::Topic::state);
     const DataWait wait(p, states.get());
-    const std::unique_ptr<Child> serve = start_serve(domain, "puma");
+    const std::unique_ptr<Child> serve = start_serve(domain, "puma", "RCCX_BENCH_STATE_CELL");
     if (!serve) {
       state.SkipWithError(kNoServe);
       return;
@@ -676,13 +682,26 @@ void BM_ServeStateOneWay(benchmark::State& state) {
 }
 BENCHMARK(BM_ServeStateOneWay)->Iterations(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 
+/// The fleet's reader: the state topic's QoS, or with RCCX_BENCH_READER_DEPTH=N (a diagnosis)
+/// keep last N per robot, so that a sample overwritten before this thread took it is told
+/// apart from one the transport lost.
+net::Entity fleet_reader(const net::Participant& p) {
+  const long depth = env_long("RCCX_BENCH_READER_DEPTH", 0);
+  if (depth <= 1) return p.reader(net::Topic::state);
+  const net::Qos qos;
+  dds_qset_reliability(qos.get(), DDS_RELIABILITY_BEST_EFFORT, 0);
+  dds_qset_history(qos.get(), DDS_HISTORY_KEEP_LAST, static_cast<int32_t>(depth));
+  return net::Entity(net::check(
+      dds_create_reader(p.get(), p.topic(net::Topic::state), qos.get(), nullptr), "reader"));
+}
+
 void state_fleet(benchmark::State& state, bool batch) {
   const std::uint32_t domain = bench_domain();
   const auto robots = static_cast<int>(state.range(0));
   const long seconds = env_long("RCCX_BENCH_FLEET_SECONDS", 3);
   for (auto _ : state) {
     const net::Participant p(options(domain, "program"));
-    const net::Entity states = p.reader(net::Topic::state);
+    const net::Entity states = fleet_reader(p);
     const DataWait wait(p, states.get());
     Child writer({"fleet-writer", std::to_string(domain), std::to_string(robots),
                   std::to_string(seconds), batch ? "1" : "0"});

@@ -60,11 +60,11 @@ dds_duration_t to_dds(std::chrono::nanoseconds d) {
 std::string domain_config(const std::string& interface) {
   if (interface.empty()) return {};
   std::string peers;
-  // Multicast "false" on loopback rather than "default": Cyclone would find it has none and say
-  // so on stderr in every process.
-  std::string multicast = "default";
+  // No multicast asked for on loopback: Cyclone would find it has none and say so on stderr in
+  // every process.
+  std::string multicast;
   if (interface == "lo" || interface == "127.0.0.1") {
-    multicast = "false";
+    multicast = "<AllowMulticast>false</AllowMulticast>";
     peers =
         "<Discovery><ParticipantIndex>auto</ParticipantIndex>"
         "<MaxAutoParticipantIndex>40</MaxAutoParticipantIndex>"
@@ -72,7 +72,7 @@ std::string domain_config(const std::string& interface) {
   }
   return fmt::format(
       "<CycloneDDS><Domain id=\"any\"><General><Interfaces><NetworkInterface name=\"{}\" "
-      "multicast=\"{}\"/></Interfaces></General>{}</Domain></CycloneDDS>",
+      "multicast=\"default\"/></Interfaces>{}</General>{}</Domain></CycloneDDS>",
       interface, multicast, peers);
 }
 
