@@ -47,7 +47,7 @@ demo-cell: build-release
 demo-distributed: build-release
 	scripts/demo-distributed --build $(RELEASE_DIR)
 
-# Debug build with AddressSanitizer and UndefinedBehaviorSanitizer, every test, then the
+# Debug build (-O1) with AddressSanitizer and UndefinedBehaviorSanitizer, every test, then the
 # fuzz targets for FUZZ_SECONDS in all.
 test: unit-tests fuzz
 
