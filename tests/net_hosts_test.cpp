@@ -220,9 +220,13 @@ double number_after(const std::string& text, const std::string& pattern) {
 /// again, on fresh hosts; the last attempt is judged whatever happens.
 constexpr int kAttempts = 3;
 
-/// True (and says so) when `program_output` shows a serve's control ended by an overrun.
+/// True (and says so) when `program_output` shows a serve's control ended by an overrun: RTC's
+/// two details of TerminateCode::overrun (the clock's watchdog, and the robot's f1 late).
 bool overran(const std::string& program_output, int attempt) {
-  if (!contains(program_output, "was still running at the next tick")) return false;
+  if (!contains(program_output, "was still running at the next tick") &&
+      !contains(program_output, "did not hand Chg over within its period")) {
+    return false;
+  }
   std::printf(
       "[ overrun  ] attempt %d: a serve's control cycle overran its period (real-time "
       "work of other processes on this machine); running the scenario again:\n%s",
