@@ -2,9 +2,11 @@
 // cut link"): the PUMA's `rccx serve` in host a, the Microbo's in host b and the program in
 // host c, three network namespaces on one segment through the test's relay (2 ms each way, 1 %
 // of frames lost each way; tests/net/netns_fixture.hpp). With that link the program's motions
-// all reach their ends and the Microbo tracks the PUMA's tool within a bound; with the link cut,
-// each serve stops its robot smoothly within the detection time and says why, and the program
-// sees its motions fail with the reason. Root only: skipped, saying why, elsewhere.
+// all reach their ends and the Microbo tracks the PUMA's tool within a bound, and the thesis's
+// circuit-board demonstration (examples/10_circuit_board --remote in host c, as
+// scripts/demo-distributed runs it on loopback) probes every pad within its error bound; with
+// the link cut, each serve stops its robot smoothly within the detection time and says why, and
+// the program sees its motions fail with the reason. Root only: skipped, saying why, elsewhere.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -218,9 +220,13 @@ double number_after(const std::string& text, const std::string& pattern) {
 /// again, on fresh hosts; the last attempt is judged whatever happens.
 constexpr int kAttempts = 3;
 
-/// True (and says so) when `program_output` shows a serve's control ended by an overrun.
+/// True (and says so) when `program_output` shows a serve's control ended by an overrun: RTC's
+/// two details of TerminateCode::overrun (the clock's watchdog, and the robot's f1 late).
 bool overran(const std::string& program_output, int attempt) {
-  if (!contains(program_output, "was still running at the next tick")) return false;
+  if (!contains(program_output, "was still running at the next tick") &&
+      !contains(program_output, "did not hand Chg over within its period")) {
+    return false;
+  }
   std::printf(
       "[ overrun  ] attempt %d: a serve's control cycle overran its period (real-time "
       "work of other processes on this machine); running the scenario again:\n%s",
@@ -449,16 +455,162 @@ TEST(NetHosts, WithTheLinkCutEachServeStopsItsRobotWithinTheDetectionTimeAndSays
   }
 }
 
-// TODO(issue 29, integrator): the thesis's demonstration itself across the namespaces, once
-// examples/10_circuit_board runs with --remote --domain D --interface IF (scripts/demo-distributed)
-// on this branch: the PUMA's and the Microbo's serves in hosts a and b, the example with --remote
-// in host c, 2 ms and 1 % loss between them; assert its exit code 0 (every pad within its error
-// bound).
+/// The pads the example probes (kPads in examples/10_circuit_board.cpp), and the CSV's header.
+constexpr int kPads = 8;
+const char* const kCsvHeader =
+    "pad,x_mm,y_mm,board_speed_mm_s,touched_s,samples,max_error_mm,mean_error_mm,end_error_mm,"
+    "hand_closed";
+
+/// One row of the example's --csv (mm, s).
+struct PadRow {
+  std::string pad;
+  double board_speed_mm_s = 0;
+  long samples = 0;
+  double max_error_mm = 0;
+};
+
+/// The CSV's rows; nullopt (and the reason in `why`) when its header is not the example's.
+std::optional<std::vector<PadRow>> pad_rows(const std::string& text, std::string& why) {
+  std::istringstream in(text);
+  std::string line;
+  if (!std::getline(in, line) || line != kCsvHeader) {
+    why = "the CSV's header is \"" + line + "\"";
+    return std::nullopt;
+  }
+  std::vector<PadRow> rows;
+  while (std::getline(in, line)) {
+    std::vector<std::string> f;
+    std::istringstream l(line);
+    for (std::string cell; std::getline(l, cell, ',');) f.push_back(cell);
+    if (f.size() != 10) {
+      why = "a CSV row without 10 fields: \"" + line + "\"";
+      return std::nullopt;
+    }
+    rows.push_back({f[0], std::stod(f[3]), std::stol(f[5]), std::stod(f[6])});
+  }
+  return rows;
+}
+
+/// True (and says so) on the first attempt when the demonstration failed on a state that came
+/// late: a peer silent past the detection time, or a collision stop whose allowance the remote
+/// robot's state's age widened. Real time on a shared machine, not the program
+/// (tests/demo_distributed_test.cmake retries on the same words).
+bool late_state(const std::string& outputs, int attempt) {
+  static const std::regex late(
+      R"(another process's, its state [0-9]+ ms old|is silent for [0-9]+ ms)");
+  if (attempt != 1 || !std::regex_search(outputs, late)) return false;
+  std::printf(
+      "[ late     ] attempt %d: the demonstration failed on a late state (a loaded machine's "
+      "scheduling, not the link's 2 ms); running it again:\n%s",
+      attempt, outputs.c_str());
+  return true;
+}
+
+void demo_once(int attempt, bool& again) {
+  netns::Hosts hosts({.hosts = 3,
+                      .delay_ms = 2.0,
+                      .loss = 0.01,
+                      .seed = static_cast<std::uint64_t>(32 + attempt)});
+  const std::string d = domain();
+  netns::Child puma = serve(hosts, 0, "puma", d);
+  netns::Child microbo = serve(hosts, 1, "microbo", d);
+  ASSERT_TRUE(serving(puma, microbo));
+  const std::string csv = ::testing::TempDir() + "rccx_hosts_pads_" + d + ".csv";
+  std::remove(csv.c_str());
+  const RemovedAtEnd remove_csv{csv};
+  const netns::RelayStats before = hosts.relay_stats();
+  const auto started = Clock::now();
+  netns::Child program = spawn_rt(
+      hosts, 2,
+      {RCCX_CIRCUIT_BOARD_EXE, "--remote", "--domain", d, "--interface", netns::Hosts::kInterface,
+       "--detection", std::to_string(kDetectionMs) + "ms", "--csv", csv});
+  // About 103 s of motion in real time. The example prints its summary with its cell still
+  // open: the serves' words then, before they take its end for its loss (a detection time on).
+  // The serves end on their own after 170 s (serve()): 160 s is as long as waiting can help.
+  for (const auto until = Clock::now() + 160s; Clock::now() < until &&
+                                               !contains(program.output(), "failures: PUMA") &&
+                                               !program.wait(0ms).has_value();) {
+    std::this_thread::sleep_for(5ms);
+  }
+  const std::string pa = puma.output(), mb = microbo.output();
+  const std::optional<int> code = program.wait(30s);
+  const double took_s = std::chrono::duration<double>(Clock::now() - started).count();
+  const netns::RelayStats after = hosts.relay_stats();
+  const std::string out = program.output();
+  if (attempt < kAttempts &&
+      (overran(out + pa + mb, attempt) || late_state(out + pa + mb, attempt))) {
+    again = true;
+    return;
+  }
+  std::printf("[ program  ]\n%s", out.c_str());
+  if (after.valid) {
+    const std::uint64_t forwarded = after.forwarded - before.forwarded;
+    const std::uint64_t lost = after.lost - before.lost;
+    std::printf(
+        "[ figures  ] relay: %llu frames forwarded, %llu lost (%.2f %%), held p50 %.3f p99 %.3f "
+        "max %.3f ms\n",
+        static_cast<unsigned long long>(forwarded), static_cast<unsigned long long>(lost),
+        100.0 * static_cast<double>(lost) /
+            static_cast<double>(std::max<std::uint64_t>(1, forwarded + lost)),
+        after.delay_p50_ms, after.delay_p99_ms, after.delay_max_ms);
+    // The link did lose frames during the demonstration: the test is of a lossy link.
+    EXPECT_GT(after.lost, before.lost);
+  }
+  ASSERT_TRUE(code.has_value()) << "the demonstration did not end in 190 s:\n"
+                                << out << "\nhost a:\n"
+                                << puma.output() << "\nhost b:\n"
+                                << microbo.output();
+  EXPECT_EQ(*code, 0) << "the demonstration did not run through, or a probe missed its pad:\n"
+                      << out << "\nhost a:\n"
+                      << puma.output() << "\nhost b:\n"
+                      << microbo.output();
+  // Its table, every pad probed, no motion failed.
+  for (const char* text : {"across processes: the PUMA served by", " pad   x mm   y mm  board",
+                           "failures: PUMA none, Microbo none"}) {
+    EXPECT_TRUE(contains(out, text)) << "the demonstration did not print \"" << text << "\":\n"
+                                     << out;
+  }
+  EXPECT_EQ(number_after(out, R"((\d+) pads probed)"), static_cast<double>(kPads)) << out;
+  const double moving = number_after(out, R"((\d+) on the moving board)");
+  EXPECT_GE(moving, 2.0) << "too few pads probed on the moving board:\n" << out;
+  const double worst_mm = number_after(out, R"(worst error ([0-9.]+) mm)");
+  const double bound_mm = number_after(out, R"(\(bound ([0-9.]+) mm\))");
+  ASSERT_GT(bound_mm, 0.0) << "the demonstration did not print its worst error and bound:\n" << out;
+  EXPECT_GE(worst_mm, 0.0) << out;
+  EXPECT_LE(worst_mm, bound_mm) << out;
+  // Every pad in the CSV: measured across hosts, and within the bound.
+  std::string why;
+  const std::optional<std::vector<PadRow>> rows = pad_rows(read_file(csv), why);
+  ASSERT_TRUE(rows.has_value()) << "--csv " << csv << ": " << why;
+  ASSERT_EQ(rows->size(), static_cast<std::size_t>(kPads)) << read_file(csv);
+  int moving_rows = 0;
+  for (const PadRow& r : *rows) {
+    EXPECT_GT(r.samples, 0) << "pad " << r.pad << ": no reading paired across hosts";
+    EXPECT_LE(r.max_error_mm, bound_mm) << "pad " << r.pad;
+    moving_rows += r.board_speed_mm_s > 0.5 ? 1 : 0;  // the example's own rule for "moving"
+  }
+  EXPECT_EQ(static_cast<double>(moving_rows), moving) << read_file(csv);
+  std::printf(
+      "[ figures  ] the demonstration across hosts (2 ms, 1 %% loss, detection %d ms): %d pads, "
+      "%d on the moving board, worst error %.3f mm (bound %.1f mm); %.1f s from start to end\n",
+      kDetectionMs, kPads, moving_rows, worst_mm, bound_mm, took_s);
+  // Nobody took a peer for lost on the way: not the serves, not the program.
+  for (const std::string* text : {&pa, &mb, &out}) {
+    EXPECT_FALSE(contains(*text, "was lost (no heartbeat")) << *text;
+    EXPECT_FALSE(contains(*text, "is silent for")) << *text;
+  }
+  program.stop();
+  puma.stop();
+  microbo.stop();
+}
+
 TEST(NetHosts, TheCircuitBoardDemonstrationAcrossHostsMeetsItsErrorBound) {
   NETNS_OR_SKIP();
-  GTEST_SKIP() << "the distributed demonstration (examples/10_circuit_board --remote, "
-                  "scripts/demo-distributed) is not on this branch yet; the integrator enables "
-                  "this test when it is";
+  for (int attempt = 1; attempt <= kAttempts; ++attempt) {
+    bool again = false;
+    demo_once(attempt, again);
+    if (!again) break;
+  }
 }
 
 }  // namespace
