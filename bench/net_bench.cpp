@@ -749,6 +749,7 @@ void state_fleet(benchmark::State& state, bool batch) {
     }
     state.counters["robots"] = robots;
     state.counters["periods"] = static_cast<double>(periods);
+    state.counters["periods_due"] = static_cast<double>(seconds * 1000);
     state.counters["late_periods"] = static_cast<double>(late);
     state.counters["write_us_per_period"] = write_us;
     state.counters["lost"] = static_cast<double>(lost);

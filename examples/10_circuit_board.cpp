@@ -352,8 +352,15 @@ class RemoteWatch final : public Watch {
     // The event's time is on the robot's serve clock; the robot's newest state maps that clock
     // to the host's (stamp_ns is the wall time its t_s stands for).
     net::RemoteArm& arm = c_.robot(robot);
+    // The wait that saw the end answers from the robot's state; the end time comes with the end
+    // event, which a frame lost on the way delays by a retransmission (up to 2 s here).
+    double end_s = arm.report(m).end_s;
+    for (int i = 0; end_s <= 0.0 && i < 2000 && controlling(); ++i) {
+      c_.wait_for(1ms);
+      end_s = arm.report(m).end_s;
+    }
     const net::RemoteState s = arm.state();
-    const double wall_ns = static_cast<double>(s.stamp_ns) - (s.t_s - arm.report(m).end_s) * 1e9;
+    const double wall_ns = static_cast<double>(s.stamp_ns) - (s.t_s - end_s) * 1e9;
     return (wall_ns - static_cast<double>(t0_ns_)) * 1e-9;
   }
   double now_s() override { return static_cast<double>(net::wall_ns() - t0_ns_) * 1e-9; }

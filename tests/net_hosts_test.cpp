@@ -465,6 +465,7 @@ const char* const kCsvHeader =
 struct PadRow {
   std::string pad;
   double board_speed_mm_s = 0;
+  double touched_s = 0;  ///< since the program started
   long samples = 0;
   double max_error_mm = 0;
 };
@@ -486,7 +487,7 @@ std::optional<std::vector<PadRow>> pad_rows(const std::string& text, std::string
       why = "a CSV row without 10 fields: \"" + line + "\"";
       return std::nullopt;
     }
-    rows.push_back({f[0], std::stod(f[3]), std::stol(f[5]), std::stod(f[6])});
+    rows.push_back({f[0], std::stod(f[3]), std::stod(f[4]), std::stol(f[5]), std::stod(f[6])});
   }
   return rows;
 }
@@ -584,8 +585,12 @@ void demo_once(int attempt, bool& again) {
   ASSERT_TRUE(rows.has_value()) << "--csv " << csv << ": " << why;
   ASSERT_EQ(rows->size(), static_cast<std::size_t>(kPads)) << read_file(csv);
   int moving_rows = 0;
+  double touched_before_s = 0;
   for (const PadRow& r : *rows) {
     EXPECT_GT(r.samples, 0) << "pad " << r.pad << ": no reading paired across hosts";
+    // Pad after pad: a touch time from an end event not yet received would read 0 or less.
+    EXPECT_GT(r.touched_s, touched_before_s) << "pad " << r.pad << "\n" << read_file(csv);
+    touched_before_s = r.touched_s;
     EXPECT_LE(r.max_error_mm, bound_mm) << "pad " << r.pad;
     moving_rows += r.board_speed_mm_s > 0.5 ? 1 : 0;  // the example's own rule for "moving"
   }
