@@ -298,7 +298,8 @@ void RobotServer::start() {
       remote_source_.mirrors.push_back(mirrors_.at(name).get());
     }
     cell_->set_remote_source(&remote_source_);
-    cell_->set_cycle_observer([this](std::uint32_t) { on_cycle(); });
+    const cell::Cell* cell = cell_.get();
+    cell_->set_cycle_observer([this, cell](std::uint32_t) { on_cycle(*cell); });
     cell_->start();
   } catch (...) {
     release_claims();
@@ -320,7 +321,7 @@ void RobotServer::stop() {
 
 // --- The control task's part -----------------------------------------------------------------
 
-void RobotServer::on_cycle() noexcept {
+void RobotServer::on_cycle(const cell::Cell& cell) noexcept {
   bool fresh = false;
   try {
     for (auto& lp : locals_) {
@@ -338,7 +339,7 @@ void RobotServer::on_cycle() noexcept {
         s.q[j] = q[j];
         s.qd[j] = q0.size() == q.size() ? (q[j] - q0[j]) / l.period_s : 0.0;
       }
-      s.tool = cell_->tool_sample(l.name);  // the seqlock: no lock, no allocation
+      s.tool = cell.tool_sample(l.name);  // the seqlock: no lock, no allocation
       s.running = l.gen->last_motion();
       // The setpoint is for two periods after this sample (Manipulator's pipeline).
       s.stamp_ns = wall_ns() + static_cast<std::int64_t>((t - s.tool.t_s) * 1e9) +

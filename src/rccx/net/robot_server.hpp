@@ -123,7 +123,9 @@ class RobotServer {
   void listen();
   /// Halts `l` smoothly; the events of its motions up to the last queued say `why`.
   void halt_with(Local& l, const std::string& why);
-  void on_cycle() noexcept;
+  /// `cell` is *cell_, passed in: ~Cell stops the tasks that call this, and unique_ptr::reset
+  /// has made cell_ null by then.
+  void on_cycle(const cell::Cell& cell) noexcept;
   [[nodiscard]] Local* local(std::string_view robot) noexcept;
 
   cell::CellModel full_model_;
