@@ -234,14 +234,56 @@ bool overran(const std::string& program_output, int attempt) {
   return true;
 }
 
+/// What the program and both serves printed, for a failure's message.
+std::string said(const std::string& program, const netns::Child& a, const netns::Child& b) {
+  return program + "\nhost a:\n" + a.output() + "\nhost b:\n" + b.output();
+}
+
+/// Prints what the relay forwarded and lost between `before` and `after`, and checks that it
+/// lost frames meanwhile: the test is of a lossy link.
+void report_relay(const netns::RelayStats& before, const netns::RelayStats& after) {
+  if (!after.valid) return;
+  const std::uint64_t forwarded = after.forwarded - before.forwarded;
+  const std::uint64_t lost = after.lost - before.lost;
+  std::printf(
+      "[ figures  ] relay: %llu frames forwarded, %llu lost (%.2f %%), held p50 %.3f p99 %.3f "
+      "max %.3f ms\n",
+      static_cast<unsigned long long>(forwarded), static_cast<unsigned long long>(lost),
+      100.0 * static_cast<double>(lost) /
+          static_cast<double>(std::max<std::uint64_t>(1, forwarded + lost)),
+      after.delay_p50_ms, after.delay_p99_ms, after.delay_max_ms);
+  EXPECT_GT(after.lost, before.lost);
+}
+
+/// The three hosts at 2 ms and 1 % loss each way (the relay's losses drawn from `seed`), the
+/// PUMA's serve in host a and the Microbo's in host b, on a domain of this test process's own.
+struct ServedHosts {
+  explicit ServedHosts(std::uint64_t seed)
+      : hosts({.hosts = 3, .delay_ms = 2.0, .loss = 0.01, .seed = seed}),
+        d(domain()),
+        puma(serve(hosts, 0, "puma", d)),
+        microbo(serve(hosts, 1, "microbo", d)) {}
+  netns::Hosts hosts;
+  std::string d;
+  netns::Child puma;
+  netns::Child microbo;
+};
+
+/// A scenario (it sets `again` to be run again on fresh hosts) up to kAttempts times.
+void run_with_attempts(void (*once)(int attempt, bool& again)) {
+  for (int attempt = 1; attempt <= kAttempts; ++attempt) {
+    bool again = false;
+    once(attempt, again);
+    if (!again) break;
+  }
+}
+
 void track_once(int attempt, bool& again) {
-  netns::Hosts hosts({.hosts = 3,
-                      .delay_ms = 2.0,
-                      .loss = 0.01,
-                      .seed = static_cast<std::uint64_t>(28 + attempt)});
-  const std::string d = domain();
-  netns::Child puma = serve(hosts, 0, "puma", d);
-  netns::Child microbo = serve(hosts, 1, "microbo", d);
+  ServedHosts served(static_cast<std::uint64_t>(28 + attempt));
+  netns::Hosts& hosts = served.hosts;
+  const std::string& d = served.d;
+  netns::Child& puma = served.puma;
+  netns::Child& microbo = served.microbo;
   ASSERT_TRUE(serving(puma, microbo));
   const netns::RelayStats before = hosts.relay_stats();
   netns::Child program = spawn_rt(hosts, 2,
@@ -263,27 +305,10 @@ void track_once(int attempt, bool& again) {
     return;
   }
   std::printf("[ program  ]\n%s", out.c_str());
-  if (after.valid) {
-    std::printf(
-        "[ figures  ] relay: %llu frames forwarded, %llu lost (%.2f %%), held p50 %.3f p99 %.3f "
-        "max %.3f ms\n",
-        static_cast<unsigned long long>(after.forwarded - before.forwarded),
-        static_cast<unsigned long long>(after.lost - before.lost),
-        100.0 * static_cast<double>(after.lost - before.lost) /
-            static_cast<double>(std::max<std::uint64_t>(
-                1, after.forwarded - before.forwarded + after.lost - before.lost)),
-        after.delay_p50_ms, after.delay_p99_ms, after.delay_max_ms);
-    // The link did lose frames during the program: the test is of a lossy link.
-    EXPECT_GT(after.lost, before.lost);
-  }
+  report_relay(before, after);
   ASSERT_TRUE(code.has_value()) << "the program did not end in 130 s:\n"
-                                << out << "\nhost a:\n"
-                                << puma.output() << "\nhost b:\n"
-                                << microbo.output();
-  EXPECT_EQ(*code, 0) << "a motion did not reach its end:\n"
-                      << out << "\nhost a:\n"
-                      << puma.output() << "\nhost b:\n"
-                      << microbo.output();
+                                << said(out, puma, microbo);
+  EXPECT_EQ(*code, 0) << "a motion did not reach its end:\n" << said(out, puma, microbo);
   const double reached = number_after(out, R"(reached (\d+) of)");
   const double total = number_after(out, R"(of (\d+) motions)");
   EXPECT_GE(total, 6.0) << out;
@@ -317,21 +342,15 @@ void track_once(int attempt, bool& again) {
 
 TEST(NetHosts, ThroughDelayAndLossEveryMotionEndsAndTheMicroboTracksThePumasTool) {
   NETNS_OR_SKIP();
-  for (int attempt = 1; attempt <= kAttempts; ++attempt) {
-    bool again = false;
-    track_once(attempt, again);
-    if (!again) break;
-  }
+  run_with_attempts(track_once);
 }
 
 void cut_once(int attempt, bool& again) {
-  netns::Hosts hosts({.hosts = 3,
-                      .delay_ms = 2.0,
-                      .loss = 0.01,
-                      .seed = static_cast<std::uint64_t>(30 + attempt)});
-  const std::string d = domain();
-  netns::Child puma = serve(hosts, 0, "puma", d);
-  netns::Child microbo = serve(hosts, 1, "microbo", d);
+  ServedHosts served(static_cast<std::uint64_t>(30 + attempt));
+  netns::Hosts& hosts = served.hosts;
+  const std::string& d = served.d;
+  netns::Child& puma = served.puma;
+  netns::Child& microbo = served.microbo;
   ASSERT_TRUE(serving(puma, microbo));
   // Recorders beside each serve: what it commands stays visible to them through the cut.
   const std::string file_a = ::testing::TempDir() + "rccx_hosts_a_" + d + ".txt";
@@ -448,11 +467,7 @@ void cut_once(int attempt, bool& again) {
 
 TEST(NetHosts, WithTheLinkCutEachServeStopsItsRobotWithinTheDetectionTimeAndSaysWhy) {
   NETNS_OR_SKIP();
-  for (int attempt = 1; attempt <= kAttempts; ++attempt) {
-    bool again = false;
-    cut_once(attempt, again);
-    if (!again) break;
-  }
+  run_with_attempts(cut_once);
 }
 
 /// The pads the example probes (kPads in examples/10_circuit_board.cpp), and the CSV's header.
@@ -508,13 +523,11 @@ bool late_state(const std::string& outputs, int attempt) {
 }
 
 void demo_once(int attempt, bool& again) {
-  netns::Hosts hosts({.hosts = 3,
-                      .delay_ms = 2.0,
-                      .loss = 0.01,
-                      .seed = static_cast<std::uint64_t>(32 + attempt)});
-  const std::string d = domain();
-  netns::Child puma = serve(hosts, 0, "puma", d);
-  netns::Child microbo = serve(hosts, 1, "microbo", d);
+  ServedHosts served(static_cast<std::uint64_t>(32 + attempt));
+  netns::Hosts& hosts = served.hosts;
+  const std::string& d = served.d;
+  netns::Child& puma = served.puma;
+  netns::Child& microbo = served.microbo;
   ASSERT_TRUE(serving(puma, microbo));
   const std::string csv = ::testing::TempDir() + "rccx_hosts_pads_" + d + ".csv";
   std::remove(csv.c_str());
@@ -544,27 +557,11 @@ void demo_once(int attempt, bool& again) {
     return;
   }
   std::printf("[ program  ]\n%s", out.c_str());
-  if (after.valid) {
-    const std::uint64_t forwarded = after.forwarded - before.forwarded;
-    const std::uint64_t lost = after.lost - before.lost;
-    std::printf(
-        "[ figures  ] relay: %llu frames forwarded, %llu lost (%.2f %%), held p50 %.3f p99 %.3f "
-        "max %.3f ms\n",
-        static_cast<unsigned long long>(forwarded), static_cast<unsigned long long>(lost),
-        100.0 * static_cast<double>(lost) /
-            static_cast<double>(std::max<std::uint64_t>(1, forwarded + lost)),
-        after.delay_p50_ms, after.delay_p99_ms, after.delay_max_ms);
-    // The link did lose frames during the demonstration: the test is of a lossy link.
-    EXPECT_GT(after.lost, before.lost);
-  }
+  report_relay(before, after);
   ASSERT_TRUE(code.has_value()) << "the demonstration did not end in 190 s:\n"
-                                << out << "\nhost a:\n"
-                                << puma.output() << "\nhost b:\n"
-                                << microbo.output();
+                                << said(out, puma, microbo);
   EXPECT_EQ(*code, 0) << "the demonstration did not run through, or a probe missed its pad:\n"
-                      << out << "\nhost a:\n"
-                      << puma.output() << "\nhost b:\n"
-                      << microbo.output();
+                      << said(out, puma, microbo);
   // Its table, every pad probed, no motion failed.
   for (const char* text : {"across processes: the PUMA served by", " pad   x mm   y mm  board",
                            "failures: PUMA none, Microbo none"}) {
@@ -611,11 +608,7 @@ void demo_once(int attempt, bool& again) {
 
 TEST(NetHosts, TheCircuitBoardDemonstrationAcrossHostsMeetsItsErrorBound) {
   NETNS_OR_SKIP();
-  for (int attempt = 1; attempt <= kAttempts; ++attempt) {
-    bool again = false;
-    demo_once(attempt, again);
-    if (!again) break;
-  }
+  run_with_attempts(demo_once);
 }
 
 }  // namespace
