@@ -217,7 +217,9 @@ double number_after(const std::string& text, const std::string& pattern) {
 /// Attempts of a scenario: a serve's control cycle that overran its period ends that robot's
 /// control (rtc's watchdog), and on this shared machine other tests' SCHED_FIFO tasks at the
 /// serves' own priorities (80 / 79) run beside them. An overrun is printed and the scenario run
-/// again, on fresh hosts; the last attempt is judged whatever happens.
+/// again, on fresh hosts; when the last attempt overran too the test is skipped, saying so (the
+/// machine could not give the serves their real time: nothing of the link was judged). Any other
+/// failure of the last attempt fails the test.
 constexpr int kAttempts = 3;
 
 /// True (and says so) when `program_output` shows a serve's control ended by an overrun: RTC's
@@ -228,11 +230,26 @@ bool overran(const std::string& program_output, int attempt) {
     return false;
   }
   std::printf(
-      "[ overrun  ] attempt %d: a serve's control cycle overran its period (real-time "
-      "work of other processes on this machine); running the scenario again:\n%s",
-      attempt, program_output.c_str());
+      "[ overrun  ] attempt %d of %d: a serve's control cycle overran its period (real-time "
+      "work of other processes on this machine):\n%s",
+      attempt, kAttempts, program_output.c_str());
   return true;
 }
+
+/// In a scenario (a void function with `attempt` and `again`): after an overrun in `text`, run
+/// again, or skip the test after the last attempt.
+#define RETRY_OR_SKIP_ON_OVERRUN(text)                                                            \
+  do {                                                                                            \
+    if (overran((text), attempt)) {                                                               \
+      if (attempt < kAttempts) {                                                                  \
+        again = true;                                                                             \
+        return;                                                                                   \
+      }                                                                                           \
+      GTEST_SKIP() << "each of the " << kAttempts                                                 \
+                   << " attempts was ended by a serve's overrun (above): this machine is too "    \
+                      "loaded to give the serves their real time; nothing of the link is judged"; \
+    }                                                                                             \
+  } while (false)
 
 /// What the program and both serves printed, for a failure's message.
 std::string said(const std::string& program, const netns::Child& a, const netns::Child& b) {
@@ -300,10 +317,7 @@ void track_once(int attempt, bool& again) {
   const std::optional<int> code = program.wait(30s);
   const netns::RelayStats after = hosts.relay_stats();
   const std::string out = program.output();
-  if (attempt < kAttempts && overran(out, attempt)) {
-    again = true;
-    return;
-  }
+  RETRY_OR_SKIP_ON_OVERRUN(out);
   std::printf("[ program  ]\n%s", out.c_str());
   report_relay(before, after);
   ASSERT_TRUE(code.has_value()) << "the program did not end in 130 s:\n"
@@ -373,10 +387,7 @@ void cut_once(int attempt, bool& again) {
     std::this_thread::sleep_for(5ms);
   }
   const bool moving = contains(program.output(), "moving");
-  if (!moving && attempt < kAttempts && overran(program.output(), attempt)) {
-    again = true;
-    return;
-  }
+  if (!moving) RETRY_OR_SKIP_ON_OVERRUN(program.output());
   ASSERT_TRUE(moving) << "the long motion did not start:\n"
                       << program.output() << "\nhost a:\n"
                       << puma.output() << "\nhost b:\n"
@@ -405,10 +416,7 @@ void cut_once(int attempt, bool& again) {
   rec_b.stop();
   const std::optional<int> code = program.wait(10s);
   const std::string out = program.output(), pa = puma.output(), mb = microbo.output();
-  if (attempt < kAttempts && overran(out, attempt)) {
-    again = true;
-    return;
-  }
+  RETRY_OR_SKIP_ON_OVERRUN(out);
   std::printf("[ program  ]\n%s[ host a   ]\n%s[ host b   ]\n%s", out.c_str(), pa.c_str(),
               mb.c_str());
 
@@ -551,8 +559,8 @@ void demo_once(int attempt, bool& again) {
   const double took_s = std::chrono::duration<double>(Clock::now() - started).count();
   const netns::RelayStats after = hosts.relay_stats();
   const std::string out = program.output();
-  if (attempt < kAttempts &&
-      (overran(out + pa + mb, attempt) || late_state(out + pa + mb, attempt))) {
+  RETRY_OR_SKIP_ON_OVERRUN(out + pa + mb);
+  if (late_state(out + pa + mb, attempt)) {  // the first attempt only
     again = true;
     return;
   }
