@@ -16,7 +16,8 @@
 // So a reader never waits for a writer that was preempted in the middle of a store (a
 // middleware thread at a low real-time priority, under the control task that reads): it reads
 // the value before. It retries only when the writer finished a whole store and began the next
-// on the same buffer during its copy, i.e. while the writer runs.
+// on the same buffer meanwhile, i.e. while the writer runs. A reader never sees an older value
+// after a newer one.
 //
 // The value is kept in atomic words so that the racing copy is defined behaviour (and
 // ThreadSanitizer sees no race); release stores and acquire loads of the words order them
@@ -51,8 +52,11 @@ class SeqLock {
       const std::uint64_t n = stores_.load(std::memory_order_acquire);
       if (n == 0) return false;
       const Buffer& b = buffers_[n & 1U];
+      // Store n itself, finished, and nothing else: a buffer lapped by store n + 2 (under way,
+      // or finished before stores_ says so) is read again from stores_, so that a reader never
+      // takes a value it could later see an older one after.
       const std::uint64_t s0 = b.seq.load(std::memory_order_acquire);
-      if ((s0 & 1U) != 0) continue;  // lapped: the writer is writing this buffer now
+      if (s0 != 2 * n) continue;
       // Acquire: the words before the re-check.
       for (std::size_t i = 0; i < kWords; ++i) w[i] = b.words[i].load(std::memory_order_acquire);
       if (b.seq.load(std::memory_order_relaxed) != s0) continue;
@@ -65,14 +69,15 @@ class SeqLock {
   friend struct SeqLockProbe;  // tests: a store begun and not finished (a preempted writer)
   static constexpr std::size_t kWords = (sizeof(T) + 7) / 8;
   struct Buffer {
-    std::atomic<std::uint64_t> seq{0};  ///< odd while written
+    std::atomic<std::uint64_t> seq{0};  ///< 2k - 1 while store k is written, 2k when finished
     std::array<std::atomic<std::uint64_t>, kWords> words{};
   };
 
-  /// The buffer the next store writes (not the one readers are sent to), made odd.
+  /// The buffer the next store (k) writes, not the one readers are sent to, marked 2k - 1.
   Buffer& begin_store() noexcept {
-    Buffer& b = buffers_[(stores_.load(std::memory_order_relaxed) + 1) & 1U];
-    b.seq.store(b.seq.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
+    const std::uint64_t k = stores_.load(std::memory_order_relaxed) + 1;
+    Buffer& b = buffers_[k & 1U];
+    b.seq.store(2 * k - 1, std::memory_order_relaxed);
     return b;
   }
   static void write_words(Buffer& b, const T& value) noexcept {
@@ -82,7 +87,7 @@ class SeqLock {
     for (std::size_t i = 0; i < kWords; ++i) b.words[i].store(w[i], std::memory_order_release);
   }
   void finish_store(Buffer& b) noexcept {
-    b.seq.store(b.seq.load(std::memory_order_relaxed) + 1, std::memory_order_release);
+    b.seq.store(b.seq.load(std::memory_order_relaxed) + 1, std::memory_order_release);  // 2k
     // Release: the buffer's words and seq before readers are sent to it.
     stores_.store(stores_.load(std::memory_order_relaxed) + 1, std::memory_order_release);
   }
