@@ -15,6 +15,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <initializer_list>
 #include <map>
 #include <optional>
 #include <regex>
@@ -23,6 +24,7 @@
 #include <thread>
 #include <vector>
 
+#include "net_path_checks.hpp"
 #include "netns_fixture.hpp"
 #include "rccx/cell/cell_model.hpp"
 #include "rccx/kinematics/kinematics.hpp"
@@ -48,13 +50,6 @@ constexpr double kPumaPeriodS = 0.007, kMicroboPeriodS = 0.028;
 /// What a loaded machine may add to any of the times measured here (scheduling of five
 /// processes and the relay on 2 cores shared with other builds): one more detection time.
 constexpr double kSlackMs = kDetectionMs;
-
-#define NETNS_OR_SKIP()                                                      \
-  do {                                                                       \
-    if (const std::string why = netns::Hosts::unavailable(); !why.empty()) { \
-      GTEST_SKIP() << why;                                                   \
-    }                                                                        \
-  } while (false)
 
 /// A domain of this test process's own (the namespaces are private, this only keeps runs of the
 /// test that overlap apart).
@@ -154,22 +149,6 @@ kin::JointVector acceleration_bounds(const std::string& robot) {
   return g.options().max_acceleration;
 }
 
-/// The largest |second difference| / P^2 over the bound, any joint, over consecutive samples
-/// from index `from` on: 1 means at the bound.
-double worst_acceleration_ratio(const std::vector<Sample>& v, std::size_t from,
-                                const kin::JointVector& bound) {
-  double worst = 0.0;
-  for (std::size_t i = std::max<std::size_t>(from, 2); i < v.size(); ++i) {
-    if (v[i].sample != v[i - 1].sample + 1 || v[i - 1].sample != v[i - 2].sample + 1) continue;
-    const double P = v[i].period_s;
-    for (std::size_t j = 0; j < v[i].q.size(); ++j) {
-      const double a = (v[i].q[j] - 2 * v[i - 1].q[j] + v[i - 2].q[j]) / (P * P);
-      worst = std::max(worst, std::abs(a) / bound[j]);
-    }
-  }
-  return worst;
-}
-
 double step(const std::vector<Sample>& v, std::size_t i) {
   double s = 0;
   for (std::size_t j = 0; j < v[i].q.size(); ++j) s += std::pow(v[i].q[j] - v[i - 1].q[j], 2);
@@ -204,7 +183,7 @@ Stop stop_of(const std::vector<Sample>& v, std::int64_t cut_wall_ns, const std::
       break;
     }
   }
-  s.accel_ratio = worst_acceleration_ratio(v, cut - 3, acceleration_bounds(robot));
+  s.accel_ratio = rccx::test::worst_acceleration_ratio(v, cut - 3, acceleration_bounds(robot));
   return s;
 }
 
@@ -250,6 +229,14 @@ bool overran(const std::string& program_output, int attempt) {
                       "loaded to give the serves their real time; nothing of the link is judged"; \
     }                                                                                             \
   } while (false)
+
+/// Nobody took a peer for lost on the way: not the serves, not the program (their outputs).
+void expect_no_peer_lost(std::initializer_list<const std::string*> outputs) {
+  for (const std::string* text : outputs) {
+    EXPECT_FALSE(contains(*text, "was lost (no heartbeat")) << *text;
+    EXPECT_FALSE(contains(*text, "is silent for")) << *text;
+  }
+}
 
 /// What the program and both serves printed, for a failure's message.
 std::string said(const std::string& program, const netns::Child& a, const netns::Child& b) {
@@ -344,11 +331,7 @@ void track_once(int attempt, bool& again) {
   EXPECT_GE(count, 50.0) << "too few samples matched: " << out;
   EXPECT_GE(worst_mm, 0.0) << out;
   EXPECT_LT(worst_mm, 1.0) << out;
-  // Nobody took a peer for lost on the way: not the serves, not the program.
-  for (const std::string* text : {&pa, &mb, &out}) {
-    EXPECT_FALSE(contains(*text, "was lost (no heartbeat")) << *text;
-    EXPECT_FALSE(contains(*text, "is silent for")) << *text;
-  }
+  expect_no_peer_lost({&pa, &mb, &out});
   program.stop();
   puma.stop();
   microbo.stop();
@@ -604,11 +587,7 @@ void demo_once(int attempt, bool& again) {
       "[ figures  ] the demonstration across hosts (2 ms, 1 %% loss, detection %d ms): %d pads, "
       "%d on the moving board, worst error %.3f mm (bound %.1f mm); %.1f s from start to end\n",
       kDetectionMs, kPads, moving_rows, worst_mm, bound_mm, took_s);
-  // Nobody took a peer for lost on the way: not the serves, not the program.
-  for (const std::string* text : {&pa, &mb, &out}) {
-    EXPECT_FALSE(contains(*text, "was lost (no heartbeat")) << *text;
-    EXPECT_FALSE(contains(*text, "is silent for")) << *text;
-  }
+  expect_no_peer_lost({&pa, &mb, &out});
   program.stop();
   puma.stop();
   microbo.stop();

@@ -155,13 +155,6 @@ bool warm_up(int fd, const sockaddr_in& to) {
   return false;
 }
 
-#define NETNS_OR_SKIP()                                                      \
-  do {                                                                       \
-    if (const std::string why = netns::Hosts::unavailable(); !why.empty()) { \
-      GTEST_SKIP() << why;                                                   \
-    }                                                                        \
-  } while (false)
-
 }  // namespace
 
 TEST(NetnsHosts, UdpAcrossTheLinkTakesTheDelayEachWayAndLosesAboutOnePercentEachWay) {

@@ -21,6 +21,7 @@
 #include <thread>
 #include <vector>
 
+#include "net_path_checks.hpp"
 #include "net_serve_helpers.hpp"
 #include "rccx/cell/cell.hpp"
 #include "rccx/cell/cell_model.hpp"
@@ -124,22 +125,6 @@ kin::JointVector acceleration_bounds(const std::string& robot) {
   o.period_s = std::chrono::duration<double>(m.period(0)).count();
   const rccl::TrajectoryGenerator g(*k, o);
   return g.options().max_acceleration;
-}
-
-/// The largest |second difference| / P^2 over bounds, per joint, over consecutive samples from
-/// index `from` on: 1 means at the bound.
-double worst_acceleration_ratio(const std::vector<StateRecorder::Record>& v, std::size_t from,
-                                const kin::JointVector& bound) {
-  double worst = 0.0;
-  for (std::size_t i = std::max<std::size_t>(from, 2); i < v.size(); ++i) {
-    if (v[i].sample != v[i - 1].sample + 1 || v[i - 1].sample != v[i - 2].sample + 1) continue;
-    const double P = v[i].period_s;
-    for (std::size_t j = 0; j < v[i].q.size(); ++j) {
-      const double a = (v[i].q[j] - 2 * v[i - 1].q[j] + v[i - 2].q[j]) / (P * P);
-      worst = std::max(worst, std::abs(a) / bound[j]);
-    }
-  }
-  return worst;
 }
 
 bool contains(const std::string& s, const std::string& part) {
@@ -375,8 +360,8 @@ TEST(NetServe, AKilledProgramsRobotStopsSmoothlyAndTheServeSaysWhy) {
   }
   ASSERT_LT(rest, v.size() - 1) << "the robot did not come to rest";
   const double moving_ms = static_cast<double>(v[rest].received_ns - killed) * 1e-6;
-  const double ratio =
-      worst_acceleration_ratio(v, kill_index > 3 ? kill_index - 3 : 0, acceleration_bounds("puma"));
+  const double ratio = rccx::test::worst_acceleration_ratio(v, kill_index > 3 ? kill_index - 3 : 0,
+                                                            acceleration_bounds("puma"));
   std::printf("kill -9 of the program -> at rest %.1f ms later; worst |accel| / bound = %.3f\n",
               moving_ms, ratio);
   EXPECT_LE(ratio, 1.0 + rccl::kAccelerationTolerance);
@@ -477,8 +462,8 @@ TEST(NetServe, ARobotFollowsAnotherProcesssRobotAndStopsWhenThatServeDies) {
   const auto v = states.of("microbo");
   std::size_t kill_index = 0;
   while (kill_index < v.size() && v[kill_index].received_ns < killed) ++kill_index;
-  const double ratio = worst_acceleration_ratio(v, kill_index > 3 ? kill_index - 3 : 0,
-                                                acceleration_bounds("microbo"));
+  const double ratio = rccx::test::worst_acceleration_ratio(v, kill_index > 3 ? kill_index - 3 : 0,
+                                                            acceleration_bounds("microbo"));
   std::printf("after the leader's serve died: worst |accel| / bound of the Microbo = %.3f\n",
               ratio);
   EXPECT_LE(ratio, 1.0 + rccl::kAccelerationTolerance);

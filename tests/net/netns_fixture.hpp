@@ -155,3 +155,11 @@ auto Hosts::in(int host, F fn) -> decltype(fn()) {
 }
 
 }  // namespace rccx::netns
+
+/// In a GoogleTest test: skips it, saying why, where Hosts cannot be made (not root, no ip).
+#define NETNS_OR_SKIP()                                                              \
+  do {                                                                               \
+    if (const std::string why = ::rccx::netns::Hosts::unavailable(); !why.empty()) { \
+      GTEST_SKIP() << why;                                                           \
+    }                                                                                \
+  } while (false)
