@@ -16,6 +16,7 @@
 #include <fstream>
 #include <map>
 #include <mutex>
+#include <span>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -58,7 +59,8 @@ std::unique_ptr<Child> serve(std::uint32_t d, const std::string& robots, const s
   return test::spawn_serve(kCell, d, robots, tag, std::chrono::milliseconds(kDetectionMs));
 }
 
-/// Every RobotState sample of the domain, one record per (robot, sample).
+/// Every RobotState sample of the domain, one record per (robot, sample), with the fields these
+/// tests read (test::StateRecorder keeps the samples whole).
 class StateRecorder {
  public:
   struct Record {
@@ -70,50 +72,26 @@ class StateRecorder {
     std::uint64_t running = 0;
     std::int64_t received_ns = 0;
   };
-  explicit StateRecorder(std::uint32_t d)
-      : participant_(loopback(d)),
-        reader_(
-            participant_.reader(net::Topic::state, std::chrono::milliseconds(kDetectionMs * 10))) {
-    thread_ = std::thread([this] {
-      rccx_net_RobotState s{};
-      void* ptrs[1] = {&s};
-      dds_sample_info_t info[1];
-      while (!stop_) {
-        while (dds_take(reader_.get(), ptrs, info, 1, 1) == 1) {
-          if (!info[0].valid_data) continue;
-          Record r;
-          r.sample = s.sample;
-          r.t_s = s.t_s;
-          r.period_s = s.period_s;
-          r.q = kin::JointVector(s.dof);
-          for (std::size_t j = 0; j < s.dof; ++j) r.q[j] = s.q_commanded[j];
-          r.tool = net::from_pose(s.tool);
-          r.running = s.running;
-          r.received_ns = now_ns();
-          std::lock_guard lock(mutex_);
-          auto& v = records_[std::string(net::text_of(s.robot))];
-          if (v.empty() || v.back().sample != r.sample) v.push_back(r);
-        }
-        std::this_thread::sleep_for(1ms);
-      }
-    });
-  }
-  ~StateRecorder() {
-    stop_ = true;
-    thread_.join();
-  }
+  explicit StateRecorder(std::uint32_t d) : recorder_(d, std::chrono::milliseconds(kDetectionMs)) {}
   std::vector<Record> of(const std::string& robot) {
-    std::lock_guard lock(mutex_);
-    return records_[robot];
+    std::vector<Record> out;
+    for (const test::StateRecorder::Record& r : recorder_.of(robot)) {
+      const rccx_net_RobotState& s = r.state;
+      Record d;
+      d.sample = s.sample;
+      d.t_s = s.t_s;
+      d.period_s = s.period_s;
+      d.q = kin::JointVector(std::span<const double>(s.q_commanded, s.dof));
+      d.tool = net::from_pose(s.tool);
+      d.running = s.running;
+      d.received_ns = r.received_ns;
+      out.push_back(d);
+    }
+    return out;
   }
 
  private:
-  net::Participant participant_;
-  net::Entity reader_;
-  std::mutex mutex_;
-  std::map<std::string, std::vector<Record>> records_;
-  std::atomic<bool> stop_{false};
-  std::thread thread_;
+  test::StateRecorder recorder_;
 };
 
 /// The generator's acceleration bounds for a robot of the cell (rad/s^2), as the serve has them.
