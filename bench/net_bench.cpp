@@ -6,7 +6,10 @@
 //                               this program acknowledging each request at once): rccx's types
 //                               and QoS without the serve's work.
 //   BM_ServeRequestAckWire      the same against a real `rccx serve` (kind attach: answered
-//                               without moving the robot), this process heartbeating as a program.
+//                               without moving the robot), this process heartbeating as a program;
+//                               the ack taken from a waitset (ddsperf -W's way).
+//   BM_ServeRequestAckWireListener  the same, the ack taken and the next request written by a
+//                               listener in Cyclone's receive thread (ddsperf's default way).
 //   BM_ServeRequestAckApi       RemoteArm::attach() through net::RemoteCell against the serve:
 //                               the round trip a program's call sees.
 //   BM_ServeStateOneWay         the serve's RobotState (the PUMA at the cell's rate, 1 kHz in
@@ -44,6 +47,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -207,16 +211,25 @@ void set_latency_counters(benchmark::State& state, std::vector<std::int64_t>& ns
   state.counters["samples"] = static_cast<double>(ns.size());
 }
 
+/// A writer of `t` reliable keep last 1, as ddsperf's ping/pong.
+net::Entity keep_last_1_writer(const net::Participant& p, net::Topic t) {
+  const net::Qos qos;
+  dds_qset_reliability(qos.get(), DDS_RELIABILITY_RELIABLE, DDS_MSECS(100));
+  dds_qset_history(qos.get(), DDS_HISTORY_KEEP_LAST, 1);
+  return net::Entity(
+      net::check(dds_create_writer(p.get(), p.topic(t), qos.get(), nullptr), "bench writer"));
+}
+
 /// A reader / writer of `t` with the topic's QoS, or, with RCCX_BENCH_KEEP_LAST=1 (a diagnosis:
 /// what keep-all costs), reliable keep last 1 as ddsperf's ping/pong.
 net::Entity endpoint(const net::Participant& p, net::Topic t, bool writer) {
   if (env_long("RCCX_BENCH_KEEP_LAST", 0) == 0) return writer ? p.writer(t) : p.reader(t);
+  if (writer) return keep_last_1_writer(p, t);
   const net::Qos qos;
   dds_qset_reliability(qos.get(), DDS_RELIABILITY_RELIABLE, DDS_MSECS(100));
   dds_qset_history(qos.get(), DDS_HISTORY_KEEP_LAST, 1);
-  const dds_entity_t e = writer ? dds_create_writer(p.get(), p.topic(t), qos.get(), nullptr)
-                                : dds_create_reader(p.get(), p.topic(t), qos.get(), nullptr);
-  return net::Entity(net::check(e, "bench endpoint"));
+  return net::Entity(
+      net::check(dds_create_reader(p.get(), p.topic(t), qos.get(), nullptr), "bench endpoint"));
 }
 
 // ---- the children ----------------------------------------------------------------------------
@@ -504,58 +517,93 @@ constexpr const char* kNoServe =
     "set RCCX_BENCH_RCCX (the rccx executable) and RCCX_BENCH_CELL (a cell file) to run "
     "against rccx serve (scripts/bench-net does)";
 
-/// The wire round trip against the real serve: this thread writes a MotionRequest of kind
-/// attach (answered without moving the robot at rest, through the serve's whole request path:
-/// its middleware thread woken, the dedup table, Manipulator::last_queued, the ack written) and
-/// takes its MotionAck from a waitset, as a program's middleware thread would; heartbeats as a
-/// program every 5 ms between round trips (outside the timed part), so the serve keeps it
-/// attached.
-void BM_ServeRequestAckWire(benchmark::State& state) {
-  const std::uint32_t domain = bench_domain();
-  const long roundtrips = env_long("RCCX_BENCH_ROUNDTRIPS", 100'000);
-  for (auto _ : state) {
-    const net::Participant p(options(domain, "program"));
-    const net::Entity requests = p.writer(net::Topic::request);
-    const net::Entity acks = p.reader(net::Topic::ack);
-    const net::Entity beats = p.writer(net::Topic::heartbeat);
-    const DataWait wait(p, acks.get());
-    const std::unique_ptr<Child> serve = start_serve(domain, "puma");
-    if (!serve) {
-      state.SkipWithError(kNoServe);
-      return;
-    }
-    if (!wait_for(
-            [&] { return writer_matches(requests.get()) > 0 && reader_matches(acks.get()) > 0; },
-            30s)) {
-      state.SkipWithError("rccx serve did not match in 30 s (see its stderr)");
-      return;
-    }
+/// What both wire cases share: this process as a program (a request writer, an ack reader, a
+/// heartbeat every 5 ms outside the timed part so the serve keeps it attached) beside a real
+/// `rccx serve` of the PUMA, matched; requests of kind attach (answered without moving the robot
+/// at rest, through the serve's whole request path: the dedup table, Manipulator::last_queued,
+/// the ack written).
+struct WireProgram {
+  net::Participant p;
+  net::Entity requests;
+  net::Entity acks;
+  net::Entity beats;
+  std::unique_ptr<Child> serve;
+  rccx_net_Heartbeat hb{};
+  rccx_net_MotionRequest req{};
+  std::chrono::steady_clock::time_point beat_at = std::chrono::steady_clock::now();
+
+  /// `keep_last_1`: the requests written reliable keep last 1 (ddsperf's ping QoS) instead of
+  /// the topic's keep all; see BM_ServeRequestAckWireListener.
+  WireProgram(std::uint32_t domain, bool keep_last_1)
+      : p(options(domain, "program")),
+        requests(keep_last_1 ? keep_last_1_writer(p, net::Topic::request)
+                             : p.writer(net::Topic::request)),
+        acks(p.reader(net::Topic::ack)),
+        beats(p.writer(net::Topic::heartbeat)) {
     const std::string program = "program/bench-" + std::to_string(getpid());
-    rccx_net_Heartbeat hb{};
     net::copy_to(hb.participant, program);
     hb.role = static_cast<std::uint8_t>(net::Role::program);
     hb.instance = 42;
     hb.period_ns = 5'000'000;
     hb.detection_ns = 20'000'000;
     net::copy_to(hb.robots, "puma");
-    rccx_net_MotionRequest req{};
     net::copy_to(req.robot, "puma");
     net::copy_to(req.program, program);
     req.program_instance = hb.instance;
     req.kind = static_cast<std::uint8_t>(net::RequestKind::attach);
+  }
+  /// Starts the serve and waits for it to match: "" when ready, else why the case skips.
+  std::string start(std::uint32_t domain) {
+    serve = start_serve(domain, "puma");
+    if (!serve) return kNoServe;
+    if (!wait_for(
+            [&] { return writer_matches(requests.get()) > 0 && reader_matches(acks.get()) > 0; },
+            30s)) {
+      return "rccx serve did not match in 30 s (see its stderr)";
+    }
+    return "";
+  }
+  void beat_if_due() {
+    if (std::chrono::steady_clock::now() < beat_at) return;
+    ++hb.seq;
+    dds_write(beats.get(), &hb);
+    beat_at += 5ms;
+  }
+  /// Takes the acks there are: true when one answers request `id`.
+  bool take_ack(std::uint64_t id) const {
+    void* buf[4] = {};
+    dds_sample_info_t info[4];
+    const dds_return_t n = dds_take(acks.get(), buf, info, 4, 4);
+    bool acked = false;
+    for (dds_return_t k = 0; k < n; ++k) {
+      acked = acked ||
+              (info[k].valid_data && static_cast<const rccx_net_MotionAck*>(buf[k])->request == id);
+    }
+    if (n > 0) dds_return_loan(acks.get(), buf, n);
+    return acked;
+  }
+};
+
+/// The wire round trip against the real serve, its ack taken by this thread from a waitset (as
+/// a program's middleware thread would): like ddsperf's ping/pong in waitset mode (-W).
+void BM_ServeRequestAckWire(benchmark::State& state) {
+  const std::uint32_t domain = bench_domain();
+  const long roundtrips = env_long("RCCX_BENCH_ROUNDTRIPS", 100'000);
+  for (auto _ : state) {
+    WireProgram w(domain, false);
+    const DataWait wait(w.p, w.acks.get());
+    if (const std::string why = w.start(domain); !why.empty()) {
+      state.SkipWithError(why.c_str());
+      return;
+    }
     std::vector<std::int64_t> ns;
     ns.reserve(static_cast<std::size_t>(roundtrips));
     const long warmup = 2000;
-    auto beat_at = std::chrono::steady_clock::now();
     for (long i = 1; i <= warmup + roundtrips; ++i) {
-      if (std::chrono::steady_clock::now() >= beat_at) {
-        ++hb.seq;
-        dds_write(beats.get(), &hb);
-        beat_at += 5ms;
-      }
-      req.request = static_cast<std::uint64_t>(i);
+      w.beat_if_due();
+      w.req.request = static_cast<std::uint64_t>(i);
       const auto t0 = std::chrono::steady_clock::now();
-      dds_write(requests.get(), &req);
+      dds_write(w.requests.get(), &w.req);
       bool acked = false;
       while (!acked) {
         // The first answers wait for the serve's cell to start.
@@ -563,23 +611,98 @@ void BM_ServeRequestAckWire(benchmark::State& state) {
           state.SkipWithError("rccx serve sent no acknowledgement in 2 s");
           return;
         }
-        void* buf[4] = {};
-        dds_sample_info_t info[4];
-        const dds_return_t n = dds_take(acks.get(), buf, info, 4, 4);
-        for (dds_return_t k = 0; k < n; ++k) {
-          const auto* a = static_cast<const rccx_net_MotionAck*>(buf[k]);
-          acked = acked || (info[k].valid_data && a->request == req.request);
-        }
-        if (n > 0) dds_return_loan(acks.get(), buf, n);
+        acked = w.take_ack(w.req.request);
       }
       const auto t1 = std::chrono::steady_clock::now();
       if (i > warmup) ns.push_back((t1 - t0).count());
     }
     set_latency_counters(state, ns);
-    (void)serve->terminate(5s);
+    (void)w.serve->terminate(5s);
   }
 }
 BENCHMARK(BM_ServeRequestAckWire)->Iterations(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+/// The same round trip with the ack taken, and the next request written, by a data-available
+/// listener in Cyclone's receive thread: like ddsperf's ping/pong in its default (listener)
+/// mode, one thread woken a message. This thread only heartbeats and watches progress. The
+/// requests are written reliable keep last 1, as ddsperf's pings: a keep-all writer in the
+/// receive thread is throttled once its unacknowledged data pass Cyclone's WhcHigh, waiting for
+/// acknowledgements that only that thread reads (it stalled after 28 requests, then timed out).
+/// The serve's side is rccx's own: its request reader and ack writer as shipped.
+void BM_ServeRequestAckWireListener(benchmark::State& state) {
+  const std::uint32_t domain = bench_domain();
+  const long roundtrips = env_long("RCCX_BENCH_ROUNDTRIPS", 100'000);
+  struct Pinger {
+    WireProgram* w = nullptr;
+    long total = 0;
+    long warmup = 2000;
+    std::vector<std::int64_t> ns;
+    std::chrono::steady_clock::time_point t0;
+    std::atomic<long> sent{0};  // the request in flight
+    std::atomic<bool> done{false};
+    void send() {
+      const long i = sent.load() + 1;
+      w->req.request = static_cast<std::uint64_t>(i);
+      t0 = std::chrono::steady_clock::now();
+      sent.store(i);
+      dds_write(w->requests.get(), &w->req);
+    }
+    void on_acks() {  // Cyclone's receive thread
+      const long i = sent.load();
+      if (done.load() || !w->take_ack(static_cast<std::uint64_t>(i))) return;
+      if (i > warmup) ns.push_back((std::chrono::steady_clock::now() - t0).count());
+      if (i < total) {
+        send();
+      } else {
+        done.store(true);
+      }
+    }
+  };
+  for (auto _ : state) {
+    WireProgram w(domain, true);
+    if (const std::string why = w.start(domain); !why.empty()) {
+      state.SkipWithError(why.c_str());
+      return;
+    }
+    Pinger ping;
+    ping.w = &w;
+    ping.total = ping.warmup + roundtrips;
+    ping.ns.reserve(static_cast<std::size_t>(roundtrips));
+    dds_listener_t* l = dds_create_listener(&ping);
+    dds_lset_data_available(l,
+                            [](dds_entity_t, void* arg) { static_cast<Pinger*>(arg)->on_acks(); });
+    net::check(dds_set_listener(w.acks.get(), l), "listener");
+    dds_delete_listener(l);
+    w.beat_if_due();
+    ping.send();
+    long seen = 0;
+    auto progress_at = std::chrono::steady_clock::now();
+    std::string failed;
+    while (!ping.done.load()) {
+      std::this_thread::sleep_for(1ms);
+      w.beat_if_due();
+      const auto now = std::chrono::steady_clock::now();
+      if (const long s = ping.sent.load(); s != seen) {
+        seen = s;
+        progress_at = now;
+      } else if (now - progress_at > (seen <= 1 ? 20s : 2s)) {  // the first waits for the cell
+        failed = "rccx serve sent no acknowledgement in 2 s";
+        break;
+      }
+    }
+    dds_set_listener(w.acks.get(), nullptr);  // waits for a callback under way
+    if (!failed.empty()) {
+      state.SkipWithError(failed.c_str());
+      return;
+    }
+    set_latency_counters(state, ping.ns);
+    (void)w.serve->terminate(5s);
+  }
+}
+BENCHMARK(BM_ServeRequestAckWireListener)
+    ->Iterations(1)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 /// What a program sees: RemoteArm::attach() through net::RemoteCell (its request written from
 /// the calling thread, the ack taken by its middleware thread from a waitset and handed over

@@ -24,6 +24,7 @@
 #include <thread>
 #include <vector>
 
+#include "net_attempts.hpp"
 #include "net_path_checks.hpp"
 #include "netns_fixture.hpp"
 #include "rccx/cell/cell_model.hpp"
@@ -193,43 +194,6 @@ double number_after(const std::string& text, const std::string& pattern) {
   return std::stod(m[1].str());
 }
 
-/// Attempts of a scenario: a serve's control cycle that overran its period ends that robot's
-/// control (rtc's watchdog), and on this shared machine other tests' SCHED_FIFO tasks at the
-/// serves' own priorities (80 / 79) run beside them. An overrun is printed and the scenario run
-/// again, on fresh hosts; when the last attempt overran too the test is skipped, saying so (the
-/// machine could not give the serves their real time: nothing of the link was judged). Any other
-/// failure of the last attempt fails the test.
-constexpr int kAttempts = 3;
-
-/// True (and says so) when `program_output` shows a serve's control ended by an overrun: RTC's
-/// two details of TerminateCode::overrun (the clock's watchdog, and the robot's f1 late).
-bool overran(const std::string& program_output, int attempt) {
-  if (!contains(program_output, "was still running at the next tick") &&
-      !contains(program_output, "did not hand Chg over within its period")) {
-    return false;
-  }
-  std::printf(
-      "[ overrun  ] attempt %d of %d: a serve's control cycle overran its period (real-time "
-      "work of other processes on this machine):\n%s",
-      attempt, kAttempts, program_output.c_str());
-  return true;
-}
-
-/// In a scenario (a void function with `attempt` and `again`): after an overrun in `text`, run
-/// again, or skip the test after the last attempt.
-#define RETRY_OR_SKIP_ON_OVERRUN(text)                                                            \
-  do {                                                                                            \
-    if (overran((text), attempt)) {                                                               \
-      if (attempt < kAttempts) {                                                                  \
-        again = true;                                                                             \
-        return;                                                                                   \
-      }                                                                                           \
-      GTEST_SKIP() << "each of the " << kAttempts                                                 \
-                   << " attempts was ended by a serve's overrun (above): this machine is too "    \
-                      "loaded to give the serves their real time; nothing of the link is judged"; \
-    }                                                                                             \
-  } while (false)
-
 /// Nobody took a peer for lost on the way: not the serves, not the program (their outputs).
 void expect_no_peer_lost(std::initializer_list<const std::string*> outputs) {
   for (const std::string* text : outputs) {
@@ -272,15 +236,6 @@ struct ServedHosts {
   netns::Child puma;
   netns::Child microbo;
 };
-
-/// A scenario (it sets `again` to be run again on fresh hosts) up to kAttempts times.
-void run_with_attempts(void (*once)(int attempt, bool& again)) {
-  for (int attempt = 1; attempt <= kAttempts; ++attempt) {
-    bool again = false;
-    once(attempt, again);
-    if (!again) break;
-  }
-}
 
 void track_once(int attempt, bool& again) {
   ServedHosts served(static_cast<std::uint64_t>(28 + attempt));
@@ -339,7 +294,7 @@ void track_once(int attempt, bool& again) {
 
 TEST(NetHosts, ThroughDelayAndLossEveryMotionEndsAndTheMicroboTracksThePumasTool) {
   NETNS_OR_SKIP();
-  run_with_attempts(track_once);
+  test::run_with_attempts(track_once);
 }
 
 void cut_once(int attempt, bool& again) {
@@ -458,7 +413,7 @@ void cut_once(int attempt, bool& again) {
 
 TEST(NetHosts, WithTheLinkCutEachServeStopsItsRobotWithinTheDetectionTimeAndSaysWhy) {
   NETNS_OR_SKIP();
-  run_with_attempts(cut_once);
+  test::run_with_attempts(cut_once);
 }
 
 /// The pads the example probes (kPads in examples/10_circuit_board.cpp), and the CSV's header.
@@ -595,7 +550,7 @@ void demo_once(int attempt, bool& again) {
 
 TEST(NetHosts, TheCircuitBoardDemonstrationAcrossHostsMeetsItsErrorBound) {
   NETNS_OR_SKIP();
-  run_with_attempts(demo_once);
+  test::run_with_attempts(demo_once);
 }
 
 }  // namespace

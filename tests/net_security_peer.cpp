@@ -4,7 +4,9 @@
 // it got.
 //
 //   net_security_peer --domain D [--secure DIR --identity NAME] --name NAME [--seconds S]
-//                     [--read-state] [--write-request]
+//                     [--read-state] [--write-request] [--read-answers]
+// --read-answers: readers of acks and events (reliable, as a program's), never taken; a test
+// stops this process (SIGSTOP) to play a frozen program whose readers acknowledge nothing.
 // Prints "participant: ok" or "participant_error: <why>" (exit 3), "reader_error: <why>",
 // "writer_error: <why>", and at the end "state_samples=<n>" and "requests_written=<n>".
 #include <cstdio>
@@ -26,6 +28,7 @@ int main(int argc, char** argv) {
   double seconds = 6.0;
   bool read_state = false;
   bool write_request = false;
+  bool read_answers = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     const auto value = [&]() -> std::string {
@@ -49,6 +52,8 @@ int main(int argc, char** argv) {
       read_state = true;
     } else if (a == "--write-request") {
       write_request = true;
+    } else if (a == "--read-answers") {
+      read_answers = true;
     } else {
       std::fprintf(stderr, "unknown argument %s\n", a.c_str());
       return 2;
@@ -77,6 +82,13 @@ int main(int argc, char** argv) {
     } catch (const net::NetError& e) {
       std::printf("writer_error: %s\n", e.what());
     }
+  }
+  net::Entity acks;
+  net::Entity events;
+  if (read_answers) {
+    acks = p->reader(net::Topic::ack);
+    events = p->reader(net::Topic::event);
+    std::printf("answers: reading\n");
   }
   std::fflush(stdout);
   long samples = 0;

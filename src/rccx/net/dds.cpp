@@ -85,7 +85,7 @@ const dds_topic_descriptor_t* topic_descriptor(Topic t) noexcept {
   return kTopics[static_cast<std::size_t>(t)].second;
 }
 
-void set_topic_qos(Qos& qos, Topic t, std::chrono::nanoseconds detection,
+void set_topic_qos(Qos& qos, Topic t, Side side, std::chrono::nanoseconds detection,
                    std::chrono::nanoseconds state_deadline) {
   dds_qos_t* q = qos.get();
   switch (t) {
@@ -105,10 +105,24 @@ void set_topic_qos(Qos& qos, Topic t, std::chrono::nanoseconds detection,
       if (state_deadline.count() > 0) dds_qset_deadline(q, to_dds(state_deadline));
       break;
     case Topic::request:
-    case Topic::ack:
-    case Topic::event:
       dds_qset_reliability(q, DDS_RELIABILITY_RELIABLE, DDS_MSECS(100));
       dds_qset_history(q, DDS_HISTORY_KEEP_ALL, 0);
+      dds_qset_destination_order(q, DDS_DESTINATIONORDER_BY_RECEPTION_TIMESTAMP);
+      break;
+    case Topic::ack:
+    case Topic::event:
+      // A serve writes these for every program on the topic. Keep all would let one program
+      // that acknowledges nothing (stopped in a debugger: matched until its lease ends) fill the
+      // writer's history and block every answer, to everyone: keep last N per instance bounds
+      // what it can hold back, and a write never waits (max_blocking_time 0; the serve keeps
+      // what it could not write yet, in order: RobotServer::Backlog). Readers keep all they
+      // get (history is not a matched QoS): a program takes them on its next pass.
+      dds_qset_reliability(q, DDS_RELIABILITY_RELIABLE, 0);
+      if (side == Side::writer) {
+        dds_qset_history(q, DDS_HISTORY_KEEP_LAST, t == Topic::ack ? kAckDepth : kEventDepth);
+      } else {
+        dds_qset_history(q, DDS_HISTORY_KEEP_ALL, 0);
+      }
       dds_qset_destination_order(q, DDS_DESTINATIONORDER_BY_RECEPTION_TIMESTAMP);
       break;
     case Topic::frame:
@@ -150,7 +164,7 @@ Participant::Participant(const NetOptions& options)
 
 Entity Participant::reader(Topic t, std::chrono::nanoseconds state_deadline) const {
   Qos qos;
-  set_topic_qos(qos, t, options_.detection, state_deadline);
+  set_topic_qos(qos, t, Side::reader, options_.detection, state_deadline);
   const dds_entity_t r = dds_create_reader(get(), topic(t), qos.get(), nullptr);
   check(r, fmt::format("a reader of {}", topic_name(t)));
   return Entity(r);
@@ -158,7 +172,7 @@ Entity Participant::reader(Topic t, std::chrono::nanoseconds state_deadline) con
 
 Entity Participant::writer(Topic t, std::chrono::nanoseconds state_deadline) const {
   Qos qos;
-  set_topic_qos(qos, t, options_.detection, state_deadline);
+  set_topic_qos(qos, t, Side::writer, options_.detection, state_deadline);
   const dds_entity_t w = dds_create_writer(get(), topic(t), qos.get(), nullptr);
   check(w, fmt::format("a writer of {}", topic_name(t)));
   return Entity(w);

@@ -60,9 +60,11 @@ class Qos {
 enum class Topic : std::uint8_t { heartbeat, claim, state, request, ack, event, frame };
 [[nodiscard]] const char* topic_name(Topic t) noexcept;
 [[nodiscard]] const dds_topic_descriptor_t* topic_descriptor(Topic t) noexcept;
-/// The QoS of a reader or writer of `t` (both sides the same, so they always match).
+enum class Side : std::uint8_t { reader, writer };
+/// The QoS of a reader or writer of `t` (the matched QoS the same on both sides, so they always
+/// match; acks' and events' writers keep last N, their readers all: topics.hpp).
 /// `state_deadline`: RobotState's deadline; `detection`: the liveliness lease of heartbeats.
-void set_topic_qos(Qos& qos, Topic t, std::chrono::nanoseconds detection,
+void set_topic_qos(Qos& qos, Topic t, Side side, std::chrono::nanoseconds detection,
                    std::chrono::nanoseconds state_deadline);
 
 /// One DDS domain participant with rccx's topics made on it, on the domain and interface of

@@ -22,15 +22,29 @@ void raise_priority() noexcept;
   return static_cast<double>(ns) * 1e-6;
 }
 
-/// Takes up to buf.size() samples of `reader` into `buf` (ptrs and info as large); returns how
-/// many were taken (0 on an error), in `info` order (invalid ones: instance state changes).
+/// Room for up to `capacity` samples of T taken off a reader, made once: a take into it
+/// allocates nothing (every rccx type is bounded, so Cyclone deserializes in place).
 template <class T>
-int take(dds_entity_t reader, std::vector<T>& buf, std::vector<void*>& ptrs,
-         std::vector<dds_sample_info_t>& info) {
-  for (std::size_t i = 0; i < buf.size(); ++i) ptrs[i] = &buf[i];
-  const dds_return_t n = dds_take(reader, ptrs.data(), info.data(), buf.size(),
-                                  static_cast<std::uint32_t>(buf.size()));
-  return n < 0 ? 0 : static_cast<int>(n);
-}
+class Inbox {
+ public:
+  explicit Inbox(std::size_t capacity) : buf_(capacity), ptrs_(capacity), info_(capacity) {
+    for (std::size_t i = 0; i < capacity; ++i) ptrs_[i] = &buf_[i];
+  }
+  /// Takes up to capacity() samples of `reader`: how many (0 on an error), in info() order
+  /// (invalid ones: instance state changes). Fewer than capacity(): the reader is empty.
+  int take(dds_entity_t reader) {
+    const dds_return_t n = dds_take(reader, ptrs_.data(), info_.data(), buf_.size(),
+                                    static_cast<std::uint32_t>(buf_.size()));
+    return n < 0 ? 0 : static_cast<int>(n);
+  }
+  [[nodiscard]] int capacity() const noexcept { return static_cast<int>(buf_.size()); }
+  [[nodiscard]] const T& operator[](int i) const { return buf_[static_cast<std::size_t>(i)]; }
+  [[nodiscard]] bool valid(int i) const { return info_[static_cast<std::size_t>(i)].valid_data; }
+
+ private:
+  std::vector<T> buf_;
+  std::vector<void*> ptrs_;
+  std::vector<dds_sample_info_t> info_;
+};
 
 }  // namespace rccx::net::detail

@@ -19,10 +19,10 @@ namespace rccx::net {
 namespace {
 
 using namespace std::chrono_literals;
+using detail::Inbox;
 using detail::ms_of;
 using detail::raise_priority;
 using detail::random_instance;
-using detail::take;
 
 rccl::MotionEvent to_event(const rccx_net_MotionEvent& e) {
   rccl::MotionEvent m;
@@ -628,53 +628,48 @@ void RemoteCell::poll(std::int64_t now) {
   }
   bool changed = false;
   {
-    std::vector<rccx_net_RobotState> buf(8);
-    std::vector<void*> ptrs(buf.size());
-    std::vector<dds_sample_info_t> info(buf.size());
+    Inbox<rccx_net_RobotState> in(8);
     for (;;) {
-      const int n = take(state_reader_.get(), buf, ptrs, info);
+      const int n = in.take(state_reader_.get());
       for (int i = 0; i < n; ++i) {
-        if (!info[i].valid_data) continue;
-        RemoteArm* a = find(text_of(buf[i].robot));
+        if (!in.valid(i)) continue;
+        RemoteArm* a = find(text_of(in[i].robot));
         if (a == nullptr) continue;
         std::lock_guard lock(mutex_);
-        const bool restarted = a->mirror_->apply(buf[i], now);
-        a->state_ = buf[i];
+        const bool restarted = a->mirror_->apply(in[i], now);
+        a->state_ = in[i];
         a->state_received_ns_ = now;
         if (!a->lost_.empty() || restarted) {
           io::eprint("rccx program: robot {} is served {}by {}\n", a->name(),
-                     restarted ? "by a new serve process: " : "again ",
-                     text_of(buf[i].participant));
+                     restarted ? "by a new serve process: " : "again ", text_of(in[i].participant));
           a->lost_.clear();
           a->mirror_->set_lost(false);
         }
         // Control ended on the serve (an overrun, a fault): the waits that now fail say why.
         // A new serve, or control running again (restarted after an overrun): a later end is
         // a new failure.
-        if (restarted || buf[i].terminate_code == 0) a->end_said_ = false;
-        if (buf[i].terminate_code != 0 && !a->end_said_) {
+        if (restarted || in[i].terminate_code == 0) a->end_said_ = false;
+        if (in[i].terminate_code != 0 && !a->end_said_) {
           a->end_said_ = true;
           const std::string why = fmt::format("robot {}'s control ended on its serve process: {}",
-                                              a->name(), text_of(buf[i].termination));
+                                              a->name(), text_of(in[i].termination));
           a->failures_.push_back(lost_event(a->last_queued_, why));
           io::eprint("rccx program: {}\n", why);
         }
         changed = true;
       }
-      if (n < static_cast<int>(buf.size())) break;
+      if (n < in.capacity()) break;
     }
   }
   {
-    std::vector<rccx_net_MotionEvent> buf(16);
-    std::vector<void*> ptrs(buf.size());
-    std::vector<dds_sample_info_t> info(buf.size());
+    Inbox<rccx_net_MotionEvent> in(16);
     for (;;) {
-      const int n = take(event_reader_.get(), buf, ptrs, info);
+      const int n = in.take(event_reader_.get());
       for (int i = 0; i < n; ++i) {
-        if (!info[i].valid_data) continue;
-        RemoteArm* a = find(text_of(buf[i].robot));
+        if (!in.valid(i)) continue;
+        RemoteArm* a = find(text_of(in[i].robot));
         if (a == nullptr) continue;
-        const rccl::MotionEvent e = to_event(buf[i]);
+        const rccl::MotionEvent e = to_event(in[i]);
         std::lock_guard lock(mutex_);
         rccl::SegmentReport& r = a->reports_[e.id];
         r.id = e.id;
@@ -689,7 +684,7 @@ void RemoteCell::poll(std::int64_t now) {
         }
         changed = true;
       }
-      if (n < static_cast<int>(buf.size())) break;
+      if (n < in.capacity()) break;
     }
   }
   // A robot whose serve process is silent for the detection time is lost.

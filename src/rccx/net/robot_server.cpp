@@ -12,6 +12,7 @@
 #include <set>
 #include <span>
 #include <stdexcept>
+#include <utility>
 
 #include "rccx/io/console.hpp"
 #include "rccx/net/codec.hpp"
@@ -23,10 +24,10 @@ namespace rccx::net {
 namespace {
 
 using namespace std::chrono_literals;
+using detail::Inbox;
 using detail::ms_of;
 using detail::raise_priority;
 using detail::random_instance;
-using detail::take;
 
 /// What the control task hands the middleware thread after a tick (trivially copyable).
 struct Slot {
@@ -80,6 +81,15 @@ struct RobotServer::Local {
   std::unique_ptr<JointStatePublisher> ros2;
 };
 
+/// Room for what a pass takes off the readers, made once (a request's answer in the receive
+/// thread allocates no take buffers).
+struct RobotServer::Inboxes {
+  Inbox<rccx_net_Heartbeat> heartbeats{16};
+  Inbox<rccx_net_RobotState> states{8};
+  Inbox<rccx_net_FrameSample> frames{8};
+  Inbox<rccx_net_MotionRequest> requests{4};
+};
+
 struct RobotServer::Dedup {
   std::uint64_t instance = 0;
   std::uint64_t highest = 0;
@@ -130,6 +140,7 @@ RobotServer::RobotServer(cell::CellModel model, std::vector<std::string> robots,
   (void)served_model(full_model_, robot_names_);  // checks the names now
   participant_name_ = "serve/" + host_and_pid();
   instance_ = random_instance();
+  inboxes_ = std::make_unique<Inboxes>();
 }
 
 RobotServer::~RobotServer() {
@@ -306,6 +317,7 @@ void RobotServer::start() {
     throw;
   }
   started_ = true;
+  answering_.store(true);
   thread_ = std::thread([this] { run(); });
 }
 
@@ -315,6 +327,11 @@ void RobotServer::stop() {
   stop_.store(true);
   rtc::detail::ring(wake_);
   if (thread_.joinable()) thread_.join();
+  {
+    // A request listener that came in before stop_ leaves first: the cell goes next.
+    const std::lock_guard pass(serve_mutex_);
+    answering_.store(false);
+  }
   release_claims();
   cell_.reset();  // ends control
 }
@@ -362,11 +379,18 @@ void RobotServer::run() noexcept {
     while (!stop_.load()) {
       // The bell's count before the pass: a ring during it makes the wait return at once.
       const std::uint32_t seen = wake_.load();
-      poll();
+      std::int64_t wake_at = 0;
+      {
+        const std::lock_guard pass(serve_mutex_);
+        poll();
+        wake_at = next_wake();
+      }
       // No spinning: a request comes seldom, and a tick's ring wakes the futex directly.
-      rtc::detail::wait_while(wake_, seen, next_wake(), 0);
+      rtc::detail::wait_while(wake_, seen, wake_at, 0);
     }
-    // Stopping: halt every robot, let them come to rest (bounded), say so in a last state.
+    // Stopping: halt every robot, let them come to rest (bounded), say so in a last state. The
+    // request listener sees stop_ and leaves the requests alone from now on.
+    const std::lock_guard pass(serve_mutex_);
     for (auto& l : locals_) halt_with(*l, "the serve process is stopping: stopped smoothly");
     const std::int64_t until = steady_ns() + 2'000'000'000;
     while (steady_ns() < until) {
@@ -390,6 +414,9 @@ void RobotServer::run() noexcept {
 
 void RobotServer::poll() {
   const std::int64_t now = steady_ns();
+  attached_since_pass_ = false;
+  acks_backlog_.flush(ack_writer_.get(), "acknowledgement");
+  events_backlog_.flush(event_writer_.get(), "motion event");
   read_heartbeats(now);
   read_states(now);
   read_frames(now);
@@ -441,14 +468,48 @@ void RobotServer::listen() {
   dds_lset_data_available(l, [](dds_entity_t, void* bell) {
     rtc::detail::ring(*static_cast<rtc::detail::Doorbell*>(bell));
   });
-  for (const Entity* r : {&request_reader_, &hb_reader_, &state_reader_, &frame_reader_}) {
-    const dds_return_t rc = dds_set_listener(r->get(), l);
-    if (rc < 0) {
-      dds_delete_listener(l);
-      check(rc, "a data-available listener");
-    }
+  dds_listener_t* r = dds_create_listener(this);
+  dds_lset_data_available(r, [](dds_entity_t, void* server) {
+    static_cast<RobotServer*>(server)->answer_in_receive_thread();
+  });
+  dds_return_t rc = dds_set_listener(request_reader_.get(), r);
+  for (const Entity* e : {&hb_reader_, &state_reader_, &frame_reader_}) {
+    if (rc >= 0) rc = dds_set_listener(e->get(), l);
   }
+  dds_delete_listener(r);
   dds_delete_listener(l);
+  check(rc, "a data-available listener");
+}
+
+void RobotServer::answer_in_receive_thread() noexcept {
+  std::unique_lock pass(serve_mutex_, std::try_to_lock);
+  if (!pass.owns_lock() || stop_.load() || !answering_.load()) {
+    // The middleware thread is in a pass (or stopping): it takes the request on its next one.
+    rtc::detail::ring(wake_);
+    return;
+  }
+  try {
+    // What a request may name arrives on the other readers: taken first, as in poll().
+    const std::int64_t now = steady_ns();
+    read_heartbeats(now);
+    read_states(now);
+    read_frames(now);
+    read_requests(now);
+  } catch (const std::exception& e) {  // an answer not written: the serve stops, saying why
+    {
+      const std::lock_guard lock(failure_mutex_);
+      failure_ = e.what();
+    }
+    stop_.store(true);
+  }
+  // The events and states an answer leads to follow the control task's ticks, which ring the
+  // middleware thread; a newly attached program's loss deadline is its own (check_lost). No ring
+  // otherwise: the middleware thread runs at a real-time priority and would take a core from the
+  // program's receive thread just as the answer reaches it.
+  if (stop_.load() || !acks_backlog_.waiting.empty() ||
+      std::exchange(attached_since_pass_, false)) {
+    rtc::detail::ring(wake_);
+  }
 }
 
 std::int64_t RobotServer::next_wake() const noexcept {
@@ -461,77 +522,69 @@ std::int64_t RobotServer::next_wake() const noexcept {
 }
 
 void RobotServer::read_heartbeats(std::int64_t now) {
-  std::vector<rccx_net_Heartbeat> buf(16);
-  std::vector<void*> ptrs(buf.size());
-  std::vector<dds_sample_info_t> info(buf.size());
+  auto& in = inboxes_->heartbeats;
   for (;;) {
-    const int n = take(hb_reader_.get(), buf, ptrs, info);
+    const int n = in.take(hb_reader_.get());
     for (int i = 0; i < n; ++i) {
-      if (!info[i].valid_data || buf[i].role != static_cast<std::uint8_t>(Role::program)) continue;
-      Program& p = programs_[std::string(text_of(buf[i].participant))];
-      p.instance = buf[i].instance;
+      if (!in.valid(i) || in[i].role != static_cast<std::uint8_t>(Role::program)) continue;
+      Program& p = programs_[std::string(text_of(in[i].participant))];
+      p.instance = in[i].instance;
       p.seen_ns = now;
     }
-    if (n < static_cast<int>(buf.size())) break;
+    if (n < in.capacity()) break;
   }
 }
 
 void RobotServer::read_states(std::int64_t now) {
-  std::vector<rccx_net_RobotState> buf(8);
-  std::vector<void*> ptrs(buf.size());
-  std::vector<dds_sample_info_t> info(buf.size());
+  auto& in = inboxes_->states;
   for (;;) {
-    const int n = take(state_reader_.get(), buf, ptrs, info);
+    const int n = in.take(state_reader_.get());
     for (int i = 0; i < n; ++i) {
-      if (!info[i].valid_data) continue;
-      const auto it = mirrors_.find(std::string(text_of(buf[i].robot)));
+      if (!in.valid(i)) continue;
+      const auto it = mirrors_.find(std::string(text_of(in[i].robot)));
       if (it == mirrors_.end()) continue;  // ours (or not of this cell)
       RobotMirror& m = *it->second;
       const bool was_lost = m.lost();
-      if (m.apply(buf[i], now) || was_lost) {
+      if (m.apply(in[i], now) || was_lost) {
         io::eprint("rccx serve: robot {} is served by {}{}\n", m.name(), m.participant(),
                    was_lost ? " again" : " (a new instance)");
       }
       if (was_lost) m.set_lost(false);
     }
-    if (n < static_cast<int>(buf.size())) break;
+    if (n < in.capacity()) break;
   }
 }
 
 void RobotServer::read_frames(std::int64_t now) {
-  std::vector<rccx_net_FrameSample> buf(8);
-  std::vector<void*> ptrs(buf.size());
-  std::vector<dds_sample_info_t> info(buf.size());
+  auto& in = inboxes_->frames;
   for (;;) {
-    const int n = take(frame_reader_.get(), buf, ptrs, info);
+    const int n = in.take(frame_reader_.get());
     for (int i = 0; i < n; ++i) {
-      if (!info[i].valid_data) continue;
-      auto& slot = streams_[std::string(text_of(buf[i].name))];
+      if (!in.valid(i)) continue;
+      auto& slot = streams_[std::string(text_of(in[i].name))];
       if (!slot) slot = std::make_unique<Stream>();
       FrameState f;
-      f.pose = from_pose(buf[i].pose);
-      f.velocity_m_per_s = {buf[i].velocity[0], buf[i].velocity[1], buf[i].velocity[2]};
-      f.angular_velocity_rad_s = {buf[i].angular_velocity[0], buf[i].angular_velocity[1],
-                                  buf[i].angular_velocity[2]};
-      f.stamp_ns = buf[i].stamp_ns;
+      f.pose = from_pose(in[i].pose);
+      f.velocity_m_per_s = {in[i].velocity[0], in[i].velocity[1], in[i].velocity[2]};
+      f.angular_velocity_rad_s = {in[i].angular_velocity[0], in[i].angular_velocity[1],
+                                  in[i].angular_velocity[2]};
+      f.stamp_ns = in[i].stamp_ns;
       slot->frame.store(f);
       slot->received_ns = now;
       slot->lost = false;
     }
-    if (n < static_cast<int>(buf.size())) break;
+    if (n < in.capacity()) break;
   }
 }
 
 void RobotServer::read_requests(std::int64_t now) {
-  std::vector<rccx_net_MotionRequest> buf(4);
-  std::vector<void*> ptrs(buf.size());
-  std::vector<dds_sample_info_t> info(buf.size());
+  auto& in = inboxes_->requests;
   for (;;) {
-    const int n = take(request_reader_.get(), buf, ptrs, info);
+    const int n = in.take(request_reader_.get());
     for (int i = 0; i < n; ++i) {
-      if (info[i].valid_data) handle(buf[i], now);
+      if (in.valid(i)) handle(in[i], now);
     }
-    if (n < static_cast<int>(buf.size())) break;
+    if (n < in.capacity()) break;
   }
 }
 
@@ -559,7 +612,7 @@ void RobotServer::handle(const rccx_net_MotionRequest& r, std::int64_t now) {
       again.motion = a.motion;
       if (a.result == static_cast<std::uint8_t>(AckResult::refused)) again = a;
     }
-    check(dds_write(ack_writer_.get(), &again), "an acknowledgement");
+    answer(again);
     return;
   }
   d.highest = r.request;
@@ -568,6 +621,7 @@ void RobotServer::handle(const rccx_net_MotionRequest& r, std::int64_t now) {
     l->program = program;
     l->program_instance = r.program_instance;
     l->attached_ns = now;
+    attached_since_pass_ = true;
   }
   rccx_net_MotionAck ack{};
   copy_to(ack.robot, l->name);
@@ -588,7 +642,50 @@ void RobotServer::handle(const rccx_net_MotionRequest& r, std::int64_t now) {
   }
   d.acks.push_back(ack);
   while (d.acks.size() > 256) d.acks.pop_front();
-  check(dds_write(ack_writer_.get(), &ack), "an acknowledgement");
+  answer(ack);
+}
+
+void RobotServer::answer(const rccx_net_MotionAck& ack) {
+  acks_backlog_.write(ack_writer_.get(), ack, "acknowledgement");
+}
+
+template <class Sample>
+void RobotServer::Backlog<Sample>::write(dds_entity_t writer, const Sample& s, const char* what) {
+  if (waiting.empty()) {
+    const dds_return_t rc = dds_write(writer, &s);
+    if (rc != DDS_RETCODE_TIMEOUT) {
+      check(rc, what);
+      return;
+    }
+  }
+  if (waiting.size() >= kBacklogLimit) {
+    waiting.pop_front();
+    ++dropped;
+  }
+  waiting.push_back(s);
+  if (!said) {
+    said = true;
+    io::eprint(
+        "rccx serve: {}s wait: a reader acknowledges nothing (a program stopped in a "
+        "debugger?); they go out when it reads again or its lease ends\n",
+        what);
+  }
+}
+
+template <class Sample>
+void RobotServer::Backlog<Sample>::flush(dds_entity_t writer, const char* what) {
+  while (!waiting.empty()) {
+    const dds_return_t rc = dds_write(writer, &waiting.front());
+    if (rc == DDS_RETCODE_TIMEOUT) return;  // still held back: the next pass tries again
+    check(rc, what);
+    waiting.pop_front();
+  }
+  if (said) {
+    io::eprint("rccx serve: {}s flow again{}\n", what,
+               dropped > 0 ? fmt::format(" ({} of the oldest dropped)", dropped) : std::string());
+    said = false;
+    dropped = 0;
+  }
 }
 
 void RobotServer::execute(Local& l, const rccx_net_MotionRequest& r, rccx_net_MotionAck& ack) {
@@ -736,7 +833,7 @@ void RobotServer::publish_events() {
       } else {
         copy_to(out.text, e.message());
       }
-      check(dds_write(event_writer_.get(), &out), "a motion event");
+      events_backlog_.write(event_writer_.get(), out, "motion event");
     }
   }
 }

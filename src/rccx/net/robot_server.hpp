@@ -13,14 +13,19 @@
 // each robot's setpoint into a triple buffer and rings a doorbell) and one middleware thread,
 // woken by that doorbell, by data arriving (Cyclone listeners ring the same doorbell) or by its
 // next deadline (heartbeat, a peer's loss): it writes states (and each robot's ROS 2 joint state)
-// and heartbeats, takes requests (all Manipulator calls are made from it), answers them at once,
-// publishes the motions' events, and stops the robots of a lost program or of a lost leader
-// smoothly (Manipulator::halt) saying why.
+// and heartbeats, takes requests, answers them at once, publishes the motions' events, and stops
+// the robots of a lost program or of a lost leader smoothly (Manipulator::halt) saying why.
+// A request is usually answered before that thread wakes: the request reader's listener, in
+// Cyclone's receive thread, takes and answers it itself when the middleware thread is not in a
+// pass (ddsperf's pong answers the same way), saving a thread wake-up per round trip. Both run
+// under serve_mutex_ (the listener only tries it, never waits), so the Manipulator calls and the
+// serve's tables still have one caller at a time.
 #pragma once
 
 #include <atomic>
 #include <chrono>
 #include <cstdint>
+#include <deque>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -91,6 +96,7 @@ class RobotServer {
  private:
   struct Local;
   struct Dedup;
+  struct Inboxes;
   struct Program {
     std::uint64_t instance = 0;
     std::int64_t seen_ns = 0;  ///< steady clock, last heartbeat
@@ -110,6 +116,8 @@ class RobotServer {
   void read_frames(std::int64_t now);
   void read_requests(std::int64_t now);
   void handle(const rccx_net_MotionRequest& r, std::int64_t now);
+  /// Writes an ack (its writer never waits: one it cannot take yet waits in acks_backlog_).
+  void answer(const rccx_net_MotionAck& ack);
   void execute(Local& l, const rccx_net_MotionRequest& r, rccx_net_MotionAck& ack);
   void publish_events();
   /// A robot whose control an overrun ended (said and published already) starts again at rest.
@@ -119,8 +127,12 @@ class RobotServer {
   /// When the middleware thread must run again with nothing arriving (steady ns): the next
   /// heartbeat, a state to repeat, a peer's loss deadline.
   [[nodiscard]] std::int64_t next_wake() const noexcept;
-  /// Cyclone's data-available listeners on the readers ring wake_ (from its receive thread).
+  /// Cyclone's data-available listeners on the readers ring wake_ (from its receive thread);
+  /// the request reader's answers requests itself (answer_in_receive_thread).
   void listen();
+  /// In Cyclone's receive thread, when a request arrived: if the middleware thread is not in a
+  /// pass (try_lock, never a wait), reads what arrived and answers the requests; else rings it.
+  void answer_in_receive_thread() noexcept;
   /// Halts `l` smoothly; the events of its motions up to the last queued say `why`.
   void halt_with(Local& l, const std::string& why);
   /// `cell` is *cell_, passed in: ~Cell stops the tasks that call this, and unique_ptr::reset
@@ -139,6 +151,13 @@ class RobotServer {
   /// stop(); the middleware thread sleeps on it (a futex: the sample loop makes no DDS call,
   /// takes no lock). Before the entities: it outlives their listeners.
   rtc::detail::Doorbell wake_;
+  /// Held by the middleware thread for each pass, tried by the request listener
+  /// (answer_in_receive_thread): what they share has one user at a time. Before the entities:
+  /// deleting a reader waits for its listener, which may hold it.
+  std::mutex serve_mutex_;
+  std::unique_ptr<Inboxes> inboxes_;  ///< serve_mutex_
+  /// The request listener answers only from the end of start() to stop().
+  std::atomic<bool> answering_{false};
   std::unique_ptr<Participant> participant_;
   Entity hb_writer_, hb_reader_, claim_writer_, claim_reader_, state_writer_, state_reader_,
       request_reader_, ack_writer_, event_writer_, frame_reader_;
@@ -165,6 +184,22 @@ class RobotServer {
   bool stopped_ = false;
   std::int64_t last_heartbeat_ns_ = 0;
   std::uint64_t heartbeat_seq_ = 0;
+  /// A request attached a program since the middleware thread's last pass (serve_mutex_).
+  bool attached_since_pass_ = false;
+  /// Samples of a reliable topic its writer could not take without waiting (a reader that
+  /// acknowledges nothing filled its history), written in order before any newer one, each
+  /// pass (serve_mutex_). Neither the receive thread nor the middleware thread ever waits.
+  template <class Sample>
+  struct Backlog {
+    static constexpr std::size_t kBacklogLimit = 100'000;  ///< then the oldest go
+    std::deque<Sample> waiting;
+    std::size_t dropped = 0;
+    bool said = false;  ///< the wait was said on stderr
+    void write(dds_entity_t writer, const Sample& s, const char* what);
+    void flush(dds_entity_t writer, const char* what);
+  };
+  Backlog<rccx_net_MotionAck> acks_backlog_;
+  Backlog<rccx_net_MotionEvent> events_backlog_;
   std::int64_t next_loss_check_ns_ = INT64_MAX;  ///< steady: the earliest a peer may be lost
   mutable std::mutex failure_mutex_;
   std::string failure_;

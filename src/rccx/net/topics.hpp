@@ -8,8 +8,8 @@
 //   rccx_claim            Claim         reliable, transient local, keep last 1
 //   rccx_state            RobotState    best effort, keep last 1, deadline (3 periods + detection)
 //   rccx_request          MotionRequest reliable, keep all, volatile (ordered per writer)
-//   rccx_ack              MotionAck     reliable, keep all
-//   rccx_event            MotionEvent   reliable, keep all
+//   rccx_ack              MotionAck     reliable, keep last kAckDepth, never blocking the writer
+//   rccx_event            MotionEvent   reliable, keep last kEventDepth, never blocking the writer
 //   rccx_frame            FrameSample   best effort, keep last 1
 #pragma once
 
@@ -37,6 +37,12 @@ inline constexpr const char* kRequestTopic = "rccx_request";
 inline constexpr const char* kAckTopic = "rccx_ack";
 inline constexpr const char* kEventTopic = "rccx_event";
 inline constexpr const char* kFrameTopic = "rccx_frame";
+
+/// Acks kept per (robot, program) instance until every reader has them: a program waits for
+/// each answer before its next request to a robot, so a live one never has this many unread.
+inline constexpr int kAckDepth = 64;
+/// Events kept per robot until every reader has them (each motion has two or three).
+inline constexpr int kEventDepth = 256;
 
 /// Heartbeat::role
 enum class Role : std::uint8_t { serve = 0, program = 1 };
