@@ -125,12 +125,28 @@ std::string failures_text(const std::vector<rccl::MotionEvent>& failures) {
   return s;
 }
 
-TEST(NetServe, ProgramMovesRobotsOfAServeAndARefusalThrowsTheServesReason) {
-  const std::uint32_t d = domain();
+// In a scenario (net_attempts.hpp) with a `why` in scope: a wait that must reach its event;
+// after a serve's overrun the attempt is run again.
+#define REACHED_OR_RETRY(wait)                                                \
+  do {                                                                        \
+    const rccl::WaitResult result = (wait);                                   \
+    if (result != rccl::WaitResult::reached) RETRY_OR_SKIP_ON_OVERRUN(why()); \
+    ASSERT_EQ(result, rccl::WaitResult::reached) << why();                    \
+  } while (false)
+
+/// One attempt of the test below (a serve's overrun runs it again, on a domain of its own).
+void moves_once(int attempt, bool& again) {
+  const std::uint32_t d = domain(attempt - 1);
   auto s = serve(d, "puma,microbo", "serve_basic");
   net::RemoteCell cell(cell::load_cell_file(kCell), loopback(d));
   net::RemoteArm& puma = cell.robot("puma");
   net::RemoteArm& microbo = cell.robot("microbo");
+  const auto why = [&] {
+    std::string text;
+    for (const auto& e : puma.failures()) text += std::string(e.message()) + "; ";
+    for (const auto& e : microbo.failures()) text += std::string(e.message()) + "; ";
+    return text + "\nserve: " + s->err();
+  };
 
   // A joint move of the PUMA.
   kin::JointVector q = puma.state().q_commanded;
@@ -145,8 +161,8 @@ TEST(NetServe, ProgramMovesRobotsOfAServeAndARefusalThrowsTheServesReason) {
   microbo.set_mode(rccl::Mode::cartesian);
   microbo.set_velocity(0.05, 0.5);
   const rccl::Motion m2 = microbo.move(cell.world_goal("microbo", "UP", up));
-  ASSERT_EQ(puma.waitfor(m1.end(), 15s), rccl::WaitResult::reached);
-  ASSERT_EQ(microbo.waitfor(m2.end(), 15s), rccl::WaitResult::reached);
+  REACHED_OR_RETRY(puma.waitfor(m1.end(), 15s));
+  REACHED_OR_RETRY(microbo.waitfor(m2.end(), 15s));
   std::this_thread::sleep_for(100ms);
   const net::RemoteState ps = puma.state();
   for (std::size_t j = 0; j < q.size(); ++j) EXPECT_NEAR(ps.q_commanded[j], q[j], 1e-6);
@@ -181,53 +197,8 @@ TEST(NetServe, ProgramMovesRobotsOfAServeAndARefusalThrowsTheServesReason) {
   EXPECT_THROW((void)puma.move(cell.world_goal("puma", "W", {f})), rccl::MotionError);
 }
 
-TEST(NetServe, ARepeatedRequestIdIsNotExecutedTwice) {
-  const std::uint32_t d = domain();
-  auto s = serve(d, "puma", "serve_dup");
-  net::RemoteOptions ro;
-  ro.robots = {"puma"};
-  net::RemoteCell cell(cell::load_cell_file(kCell), loopback(d), ro);  // waits for the serve
-  const std::uint64_t before = cell.robot("puma").state().queued;
-
-  // A program by hand: a raw writer sends request 1 twice.
-  const net::Participant p(loopback(d));
-  const net::Entity w = p.writer(net::Topic::request);
-  const net::Entity r = p.reader(net::Topic::ack);
-  const net::Entity hb = p.writer(net::Topic::heartbeat);
-  rccx_net_MotionRequest req{};
-  net::copy_to(req.robot, "puma");
-  net::copy_to(req.program, "program/test/dup");
-  req.program_instance = 99;
-  req.request = 1;
-  req.kind = static_cast<std::uint8_t>(net::RequestKind::dwell);
-  net::encode_settings(rccl::MotionSettings{}, req);
-  req.value = 0.05;
-  std::vector<rccx_net_MotionAck> acks;
-  const auto until = std::chrono::steady_clock::now() + 10s;
-  int sent = 0;
-  while (acks.size() < 2 && std::chrono::steady_clock::now() < until) {
-    dds_publication_matched_status_t st{};
-    dds_get_publication_matched_status(w.get(), &st);
-    if (st.current_count > 0 && sent < 2) {
-      ASSERT_GE(dds_write(w.get(), &req), 0);
-      ++sent;
-    }
-    rccx_net_MotionAck a{};
-    void* ptrs[1] = {&a};
-    dds_sample_info_t info[1];
-    while (dds_take(r.get(), ptrs, info, 1, 1) == 1) {
-      if (info[0].valid_data && net::text_of(a.program) == "program/test/dup") acks.push_back(a);
-    }
-    std::this_thread::sleep_for(5ms);
-  }
-  ASSERT_EQ(acks.size(), 2U);
-  EXPECT_EQ(acks[0].result, static_cast<std::uint8_t>(net::AckResult::accepted));
-  EXPECT_EQ(acks[1].result, static_cast<std::uint8_t>(net::AckResult::duplicate));
-  EXPECT_EQ(acks[0].motion, before + 1);
-  EXPECT_EQ(acks[1].motion, acks[0].motion);
-  std::this_thread::sleep_for(200ms);
-  EXPECT_EQ(cell.robot("puma").state().queued, before + 1) << "the dwell was queued twice";
-  (void)hb;
+TEST(NetServe, ProgramMovesRobotsOfAServeAndARefusalThrowsTheServesReason) {
+  test::run_with_attempts(moves_once);
 }
 
 /// A program by hand (raw DDS: a request writer, an ack reader, heartbeats), for requests
@@ -319,18 +290,47 @@ struct RawProgram {
   rccx_net_MotionRequest req{};
 };
 
+/// The PUMA served in a process of its own, and a program's RemoteCell on it (made once the
+/// serve's state arrives).
+struct ServedPuma {
+  ServedPuma(std::uint32_t d, const std::string& tag)
+      : process(serve(d, "puma", tag)), cell(cell::load_cell_file(kCell), loopback(d), [] {
+          net::RemoteOptions ro;
+          ro.robots = {"puma"};
+          return ro;
+        }()) {}
+  [[nodiscard]] std::uint64_t queued() { return cell.robot("puma").state().queued; }
+  std::unique_ptr<Child> process;
+  net::RemoteCell cell;
+};
+
+TEST(NetServe, ARepeatedRequestIdIsNotExecutedTwice) {
+  ServedPuma puma(domain(), "serve_dup");
+  const std::uint64_t before = puma.queued();
+  RawProgram program(domain(), "program/test/dup");
+  ASSERT_TRUE(program.matched(10s)) << "the serve did not match";
+  program.send(1, 1);  // a dwell
+  program.send(1, 1);  // the same id again
+  const auto acks = program.answers(2, 10s);
+  ASSERT_EQ(acks.size(), 1U);
+  const auto& a = acks.at(1);
+  ASSERT_EQ(a.size(), 2U);
+  EXPECT_EQ(a[0].result, static_cast<std::uint8_t>(net::AckResult::accepted));
+  EXPECT_EQ(a[1].result, static_cast<std::uint8_t>(net::AckResult::duplicate));
+  EXPECT_EQ(a[0].motion, before + 1);
+  EXPECT_EQ(a[1].motion, a[0].motion);
+  std::this_thread::sleep_for(200ms);
+  EXPECT_EQ(puma.queued(), before + 1) << "the dwell was queued twice";
+}
+
 // A burst of requests written back to back, faster than one answer each: the serve answers
 // them in Cyclone's receive thread, in its middleware thread when that one is in a pass, or
 // there again when an ack would have blocked the receive thread (RobotServer::answer). Whichever
 // way, every request is answered once, in the order written, and a repeated id is not executed.
 TEST(NetServe, ABurstOfRequestsIsAnsweredOnceEachInTheOrderWritten) {
-  const std::uint32_t d = domain();
-  auto s = serve(d, "puma", "serve_burst");
-  net::RemoteOptions ro;
-  ro.robots = {"puma"};
-  net::RemoteCell cell(cell::load_cell_file(kCell), loopback(d), ro);  // waits for the serve
-  const std::uint64_t before = cell.robot("puma").state().queued;
-  RawProgram program(d, "program/test/burst");
+  ServedPuma puma(domain(), "serve_burst");
+  const std::uint64_t before = puma.queued();
+  RawProgram program(domain(), "program/test/burst");
   ASSERT_TRUE(program.matched(10s)) << "the serve did not match";
   constexpr std::uint64_t kRequests = 2000;
   constexpr std::uint64_t kRepeated = 20;
@@ -341,8 +341,7 @@ TEST(NetServe, ABurstOfRequestsIsAnsweredOnceEachInTheOrderWritten) {
   RawProgram::expect_answered_in_order(program.answers(kRequests + kRepeated, 30s), kRequests,
                                        kRepeated, kDwellEvery, before);
   std::this_thread::sleep_for(200ms);
-  EXPECT_EQ(cell.robot("puma").state().queued, before + kRequests / kDwellEvery)
-      << "a dwell was queued twice";
+  EXPECT_EQ(puma.queued(), before + kRequests / kDwellEvery) << "a dwell was queued twice";
 }
 
 // A program stopped in a debugger (here SIGSTOP) keeps its ack and event readers matched while
@@ -350,11 +349,8 @@ TEST(NetServe, ABurstOfRequestsIsAnsweredOnceEachInTheOrderWritten) {
 // answer for it. The serve must go on answering the other programs, at once, and keep serving.
 TEST(NetServe, AFrozenProgramDoesNotStopTheServeAnsweringAnother) {
   const std::uint32_t d = domain();
-  auto s = serve(d, "puma", "serve_frozen");
-  net::RemoteOptions ro;
-  ro.robots = {"puma"};
-  net::RemoteCell cell(cell::load_cell_file(kCell), loopback(d), ro);
-  const std::uint64_t before = cell.robot("puma").state().queued;
+  ServedPuma puma(d, "serve_frozen");
+  const std::uint64_t before = puma.queued();
   Child frozen({RCCX_NET_PEER, "--domain", std::to_string(d), "--name", "frozen", "--read-answers",
                 "--seconds", "120"},
                "frozen_peer");
@@ -386,9 +382,10 @@ TEST(NetServe, AFrozenProgramDoesNotStopTheServeAnsweringAnother) {
       static_cast<unsigned long long>(kRequests), took_s);
   kill(frozen.pid(), SIGKILL);
   kill(frozen.pid(), SIGCONT);
-  EXPECT_FALSE(contains(s->err(), "stopped on an error")) << s->err();
+  const std::string said = puma.process->err();
+  EXPECT_FALSE(contains(said, "stopped on an error")) << said;
   // Still serving: the first program's call goes through.
-  EXPECT_NO_THROW(cell.robot("puma").attach()) << s->err();
+  EXPECT_NO_THROW(puma.cell.robot("puma").attach()) << said;
 }
 
 TEST(NetServe, ASecondServeOfARobotIsRefusedNamingTheHolder) {
@@ -544,13 +541,6 @@ void follow_once(int attempt, bool& again) {
     for (const auto& e : microbo.failures()) s += std::string(e.message()) + "; ";
     return s + "\nleader's serve: " + sp->err() + "\nfollower's serve: " + sm->err();
   };
-// A wait that must reach its event: after a serve's overrun the attempt is run again.
-#define REACHED_OR_RETRY(wait)                                                \
-  do {                                                                        \
-    const rccl::WaitResult result = (wait);                                   \
-    if (result != rccl::WaitResult::reached) RETRY_OR_SKIP_ON_OVERRUN(why()); \
-    ASSERT_EQ(result, rccl::WaitResult::reached) << why();                    \
-  } while (false)
   // The PUMA's tool over the board, pointing down; the Microbo's 150 mm to +x of it (as the
   // one-process CellRuntime.TheMicroboFollowsAFrameThePumaMoves places them: each process's
   // collision check keeps them apart, the other's state aged by its transit).
@@ -612,7 +602,6 @@ void follow_once(int attempt, bool& again) {
     last_change += std::abs(v.back().q[j] - v[v.size() - 2].q[j]);
   }
   EXPECT_LT(last_change, 1e-9) << "the Microbo still moves";
-#undef REACHED_OR_RETRY
 }
 
 TEST(NetServe, ARobotFollowsAnotherProcesssRobotAndStopsWhenThatServeDies) {
