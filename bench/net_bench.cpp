@@ -35,7 +35,8 @@
 // gives it one with a 1 ms period, the round trips the cell as shipped),
 // RCCX_BENCH_READER_DEPTH (the fleet reader's keep-last depth, 1: see fleet_reader),
 // RCCX_BENCH_SECURE_DIR (DDS Security's files of rccx certs init, identities "program" here and
-// "puma" in the child and the serve).
+// "puma" in the child and the serve), RCCX_BENCH_SERVE_OPTIONS (more options for the serve, a
+// diagnosis: "--no-ros2").
 // Diagnoses: RCCX_BENCH_LISTENER=1 (the responder answers from a listener, in Cyclone's receive
 // thread), RCCX_BENCH_KEEP_LAST=1 (request and ack reliable keep last 1, as ddsperf's ping/pong).
 #include <benchmark/benchmark.h>
@@ -53,6 +54,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <memory>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -509,6 +511,11 @@ std::unique_ptr<Child> start_serve(std::uint32_t domain, const char* robots,
                                 "--seconds",   "900"};
   if (const char* dir = std::getenv("RCCX_BENCH_SECURE_DIR"); dir != nullptr && *dir != '\0') {
     argv.insert(argv.end(), {"--secure", dir, "--identity", "puma"});
+  }
+  // A diagnosis: more options for the serve, space-separated (e.g. "--no-ros2").
+  if (const char* extra = std::getenv("RCCX_BENCH_SERVE_OPTIONS"); extra != nullptr) {
+    std::istringstream words(extra);
+    for (std::string w; words >> w;) argv.push_back(w);
   }
   return std::make_unique<Child>(Child::Program{}, argv);
 }
