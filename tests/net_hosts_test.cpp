@@ -453,14 +453,16 @@ std::optional<std::vector<PadRow>> pad_rows(const std::string& text, std::string
   return rows;
 }
 
-/// True (and says so) on the first attempt when the demonstration failed on a state that came
-/// late: a peer silent past the detection time, or a collision stop whose allowance the remote
-/// robot's state's age widened. Real time on a shared machine, not the program
-/// (tests/demo_distributed_test.cmake retries on the same words).
+/// True (and says so) before the last attempt when the demonstration failed on a state that
+/// came late: a peer silent past the detection time, or a collision stop whose allowance the
+/// remote robot's state's age widened (one of the link's 1 % lost states is enough where the
+/// probe works beside the PUMA's gripper: 33 mm apart, 33 mm needed, seen once in a clean-clone
+/// run). Real time on a shared machine and the lossy link, not the program
+/// (tests/demo_distributed_test.cmake retries on the same words). The last attempt must pass.
 bool late_state(const std::string& outputs, int attempt) {
   static const std::regex late(
       R"(another process's, its state [0-9]+ ms old|is silent for [0-9]+ ms)");
-  if (attempt != 1 || !std::regex_search(outputs, late)) return false;
+  if (attempt >= test::kAttempts || !std::regex_search(outputs, late)) return false;
   std::printf(
       "[ late     ] attempt %d: the demonstration failed on a late state (a loaded machine's "
       "scheduling, not the link's 2 ms); running it again:\n%s",
@@ -498,7 +500,7 @@ void demo_once(int attempt, bool& again) {
   const netns::RelayStats after = hosts.relay_stats();
   const std::string out = program.output();
   RETRY_OR_SKIP_ON_OVERRUN(out + pa + mb);
-  if (late_state(out + pa + mb, attempt)) {  // the first attempt only
+  if (late_state(out + pa + mb, attempt)) {
     again = true;
     return;
   }
