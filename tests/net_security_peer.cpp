@@ -17,6 +17,7 @@
 #include <thread>
 
 #include "rccx/net/dds.hpp"
+#include "rccx/net/states.hpp"
 
 using namespace rccx;
 using namespace std::chrono_literals;
@@ -91,6 +92,7 @@ int main(int argc, char** argv) {
     std::printf("answers: reading\n");
   }
   std::fflush(stdout);
+  net::StateInbox states;
   long samples = 0;
   long written = 0;
   const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
@@ -108,12 +110,9 @@ int main(int argc, char** argv) {
       std::free(r);
     }
     if (reader) {
-      rccx_net_RobotState in{};
-      void* s[1] = {&in};
-      dds_sample_info_t info[1];
-      while (dds_take(reader.get(), s, info, 1, 1) == 1) {
-        if (info[0].valid_data && std::strcmp(in.robot, "puma") == 0) ++samples;
-      }
+      states.drain(reader.get(), [&](const rccx_net_RobotState& in) {
+        if (std::strcmp(in.robot, "puma") == 0) ++samples;
+      });
     }
     std::this_thread::sleep_for(20ms);
   }

@@ -5,23 +5,32 @@
 // that do not cover a topic does not. Each negative test runs a valid program beside the
 // rejected one in the same exchange, so it cannot pass because nothing crossed at all.
 // Also `rccx certs`: the files, their modes, OpenSSL's own verdict on them, bad arguments.
+#include <arpa/inet.h>
 #include <gtest/gtest.h>
+#include <linux/if_ether.h>
+#include <linux/if_packet.h>
+#include <net/if.h>
+#include <sys/socket.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include <atomic>
+#include <cerrno>
 #include <chrono>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <set>
 #include <sstream>
 #include <string>
+#include <string_view>
 #include <thread>
 #include <vector>
 
 #include "rccx/net/certs.hpp"
 #include "rccx/net/dds.hpp"
+#include "rccx/net/states.hpp"
 #include "shell_run.hpp"
 
 using namespace rccx;
@@ -36,10 +45,12 @@ std::uint32_t test_domain() {
 }
 
 /// The certificates of the tests, made once: DIR with puma, microbo (serve), program, and the
-/// bad cases; OTHER, a second CA with its own "program".
+/// bad cases; OTHER, a second CA with its own "program"; PAYLOAD, a CA whose governance protects
+/// the payloads only (Protection::payload), with puma and program.
 struct Certs {
   fs::path dir;
   fs::path other;
+  fs::path payload;
 };
 
 const Certs& certs() {
@@ -52,7 +63,7 @@ const Certs& certs() {
       std::error_code ec;
       fs::remove_all(root, ec);
     });
-    Certs out{root / "cell", root / "other"};
+    Certs out{root / "cell", root / "other", root / "payload"};
     net::make_ca(out.dir, {});
     for (const char* n : {"puma", "microbo", "program"}) net::issue_participant(out.dir, n, {});
     net::ParticipantOptions expired;
@@ -67,6 +78,8 @@ const Certs& certs() {
     net::issue_participant(out.dir, "program-nostate", no_state);
     net::make_ca(out.other, {});
     net::issue_participant(out.other, "program", {});
+    net::make_ca(out.payload, {.protection = net::Protection::payload});
+    for (const char* n : {"puma", "program"}) net::issue_participant(out.payload, n, {});
     return out;
   }();
   return c;
@@ -100,13 +113,14 @@ struct Exchange {
   long state_written = 0;
 };
 
-/// Runs puma (secure, in this process) while `peers` run for `seconds` each in processes of
-/// their own, all at once; fills in each peer's output.
-Exchange run_exchange(std::vector<Peer>& peers, double seconds = 6.0) {
+/// Runs puma (secure with `dir`'s files, in this process) while `peers` run for `seconds` each in
+/// processes of their own, all at once; fills in each peer's output.
+Exchange run_exchange(std::vector<Peer>& peers, double seconds = 6.0,
+                      const fs::path& dir = certs().dir) {
   net::NetOptions o;
   o.domain = test_domain();
   o.interface = "lo";
-  o.secure_dir = certs().dir;
+  o.secure_dir = dir;
   o.secure_identity = "puma";
   const net::Participant puma(o);
   const net::Entity state = puma.writer(net::Topic::state);
@@ -124,15 +138,16 @@ Exchange run_exchange(std::vector<Peer>& peers, double seconds = 6.0) {
     });
   }
   Exchange ex;
-  rccx_net_RobotState s{};
-  net::copy_to(s.robot, "puma");
-  net::copy_to(s.participant, "serve/test");
+  net::StateBatch batch("serve/test", 1, 1);
   // The peers end by themselves after `seconds` (plus their start); puma serves until then.
   const auto until =
       std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds) + 30s;
   while (done < peers.size() && std::chrono::steady_clock::now() < until) {
+    rccx_net_RobotState& s = batch.add();
+    net::copy_to(s.robot, "puma");
+    net::copy_to(s.participant, "serve/test");
     s.sample = static_cast<unsigned long long>(++ex.state_written);
-    EXPECT_GE(dds_write(state.get(), &s), 0);
+    EXPECT_GE(batch.write(state.get()), 0);
     auto* in = static_cast<rccx_net_MotionRequest*>(std::calloc(1, sizeof(rccx_net_MotionRequest)));
     void* samples[1] = {in};
     dds_sample_info_t info[1];
@@ -160,6 +175,68 @@ void expect_rejected(const Peer& rejected, const std::string& name, const Exchan
   EXPECT_LE(rejected.value("state_samples"), 0) << rejected.out;
   EXPECT_EQ(ex.requests_from.count(name), 0U) << name << "'s requests reached puma";
 }
+
+/// Every packet on loopback while it lives (an AF_PACKET socket: root or CAP_NET_RAW), searched
+/// for byte strings: what crossed the wire in clear. Packets go both ways on "lo", so each is
+/// seen twice.
+class LoopbackSniffer {
+ public:
+  explicit LoopbackSniffer(std::vector<std::string> needles) : needles_(std::move(needles)) {
+    fd_ = socket(AF_PACKET, SOCK_RAW | SOCK_CLOEXEC, htons(ETH_P_ALL));
+    if (fd_ < 0) {
+      why_not_ = std::string("an AF_PACKET socket: ") + std::strerror(errno) +
+                 " (needs root or CAP_NET_RAW)";
+      return;
+    }
+    sockaddr_ll at{};
+    at.sll_family = AF_PACKET;
+    at.sll_protocol = htons(ETH_P_ALL);
+    at.sll_ifindex = static_cast<int>(if_nametoindex("lo"));
+    if (at.sll_ifindex == 0 || bind(fd_, reinterpret_cast<sockaddr*>(&at), sizeof at) != 0) {
+      why_not_ = std::string("binding to lo: ") + std::strerror(errno);
+      return;
+    }
+    timeval tv{0, 100'000};  // recv wakes to see stop_
+    setsockopt(fd_, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
+    found_.assign(needles_.size(), 0);
+    thread_ = std::thread([this] {
+      std::vector<char> buf(1 << 16);
+      while (!stop_) {
+        const ssize_t n = recv(fd_, buf.data(), buf.size(), 0);
+        if (n <= 0) continue;
+        const std::string_view pkt(buf.data(), static_cast<std::size_t>(n));
+        if (pkt.find("RTPS") != std::string_view::npos) ++rtps_packets_;
+        for (std::size_t i = 0; i < needles_.size(); ++i) {
+          if (pkt.find(needles_[i]) != std::string_view::npos) ++found_[i];
+        }
+      }
+    });
+  }
+  ~LoopbackSniffer() {
+    stop();
+    if (fd_ >= 0) close(fd_);
+  }
+  LoopbackSniffer(const LoopbackSniffer&) = delete;
+  LoopbackSniffer& operator=(const LoopbackSniffer&) = delete;
+  void stop() {
+    stop_ = true;
+    if (thread_.joinable()) thread_.join();
+  }
+  /// Empty when sniffing; else why not.
+  [[nodiscard]] const std::string& why_not() const { return why_not_; }
+  /// After stop(): packets with RTPS's magic seen, and packets holding needle i.
+  [[nodiscard]] long rtps_packets() const { return rtps_packets_; }
+  [[nodiscard]] long found(std::size_t i) const { return found_[i]; }
+
+ private:
+  std::vector<std::string> needles_;
+  std::vector<long> found_;
+  long rtps_packets_ = 0;
+  int fd_ = -1;
+  std::string why_not_;
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
+};
 
 }  // namespace
 
@@ -232,6 +309,31 @@ TEST(NetSecurity, AServeProcessCannotSendMotionRequests) {
   EXPECT_EQ(ex.requests_from.count("microbo"), 0U);
   // Serves read each other's state (frames, collision checks): that it may.
   EXPECT_GT(peers[1].value("state_samples"), 0) << peers[1].out;
+}
+
+// Protection::payload leaves the headers clear: it must still keep out a participant with no
+// certificate or another CA's, and nothing of the data may cross loopback in clear. The state's
+// participant and the program's name are inside the payloads only.
+TEST(NetSecurity, PayloadProtectionKeepsOutTheUncertifiedAndSendsNoDataInClear) {
+  const std::string program_name = "prog-q7Zx3k";  // MotionRequest::program, in its payload
+  const std::string state_marker = "serve/test";   // RobotState::participant (run_exchange)
+  LoopbackSniffer sniffer({program_name, state_marker});
+  if (!sniffer.why_not().empty()) GTEST_SKIP() << "cannot watch loopback: " << sniffer.why_not();
+  std::vector<Peer> peers{secure_peer(certs().payload, "program", program_name),
+                          Peer{"--name plain --read-state --write-request", "", -1},
+                          secure_peer(certs().other, "program", "intruder")};
+  const Exchange ex = run_exchange(peers, 6.0, certs().payload);
+  sniffer.stop();
+  EXPECT_EQ(peers[0].exit_code, 0) << peers[0].out;
+  EXPECT_GT(peers[0].value("state_samples"), 0) << "the valid program read no state:\n"
+                                                << peers[0].out;
+  EXPECT_EQ(ex.requests_from.count(program_name), 1U) << "puma read no request of the program";
+  expect_rejected(peers[1], "plain", ex);
+  expect_rejected(peers[2], "intruder", ex);
+  // The sniffer saw the traffic (hundreds of states and requests, each seen twice), and no data.
+  EXPECT_GT(sniffer.rtps_packets(), 200) << "the sniffer missed the exchange";
+  EXPECT_EQ(sniffer.found(0), 0) << "a request's program name crossed loopback in clear";
+  EXPECT_EQ(sniffer.found(1), 0) << "a state's payload crossed loopback in clear";
 }
 
 TEST(NetSecurity, AMissingFileIsNamedWithTheCommandToRun) {
@@ -342,6 +444,28 @@ TEST(NetSecurityCli, InitMakesEveryFileWithPrivateModes) {
   EXPECT_NE(other.exit_code, 0) << other.out;
 }
 
+TEST(NetSecurityCli, ProtectionChoosesWhatTheGovernanceEncrypts) {
+  // The governance's XML is in clear inside its S/MIME file (CRLF line ends).
+  const fs::path full = fresh_dir("cli-full");
+  ASSERT_EQ(test::rccx_run("certs init " + full.string() + " --participants puma").exit_code, 0);
+  const std::string f = text_of(full / "governance.p7s");
+  EXPECT_NE(f.find("<rtps_protection_kind>ENCRYPT"), std::string::npos) << f;
+  EXPECT_NE(f.find("<metadata_protection_kind>ENCRYPT"), std::string::npos) << f;
+  EXPECT_EQ(f.find("_protection_kind>NONE"), std::string::npos) << f;
+  const fs::path payload = fresh_dir("cli-payload");
+  const test::ShellRun r = test::rccx_run("certs init " + payload.string() +
+                                          " --participants puma --protection payload");
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_NE(r.out.find("payload protection"), std::string::npos) << r.out;
+  const std::string p = text_of(payload / "governance.p7s");
+  EXPECT_NE(p.find("<rtps_protection_kind>NONE"), std::string::npos) << p;
+  EXPECT_NE(p.find("<metadata_protection_kind>NONE"), std::string::npos) << p;
+  EXPECT_NE(p.find("<data_protection_kind>ENCRYPT"), std::string::npos) << p;
+  EXPECT_EQ(p.find("<data_protection_kind>NONE"), std::string::npos) << p;
+  EXPECT_NE(p.find("<discovery_protection_kind>ENCRYPT"), std::string::npos) << p;
+  EXPECT_NE(p.find("<allow_unauthenticated_participants>false"), std::string::npos) << p;
+}
+
 TEST(NetSecurityCli, AnExistingCaIsKeptUnlessForced) {
   const fs::path d = fresh_dir("cli-force");
   ASSERT_EQ(test::rccx_run("certs init " + d.string() + " --participants puma").exit_code, 0);
@@ -363,15 +487,17 @@ TEST(NetSecurityCli, AnExistingCaIsKeptUnlessForced) {
 
 TEST(NetSecurityCli, BadArgumentsExitTwoAndWriteNothing) {
   const fs::path d = fresh_dir("cli-bad");
-  const std::vector<std::string> bad{"certs init " + d.string() + " --participants 'pu ma'",
-                                     "certs init " + d.string() + " --participants puma,puma",
-                                     "certs init " + d.string() + " --participants puma,../x",
-                                     "certs init " + d.string() + " --participants private",
-                                     "certs init " + d.string() + " --participants puma --days 0",
-                                     "certs init " + d.string(),
-                                     "certs init --participants puma",
-                                     "certs add " + d.string() + " --participant puma",
-                                     "certs frobnicate"};
+  const std::vector<std::string> bad{
+      "certs init " + d.string() + " --participants 'pu ma'",
+      "certs init " + d.string() + " --participants puma,puma",
+      "certs init " + d.string() + " --participants puma,../x",
+      "certs init " + d.string() + " --participants private",
+      "certs init " + d.string() + " --participants puma --days 0",
+      "certs init " + d.string() + " --participants puma --protection none",
+      "certs init " + d.string(),
+      "certs init --participants puma",
+      "certs add " + d.string() + " --participant puma",
+      "certs frobnicate"};
   for (const std::string& args : bad) {
     const test::ShellRun r = test::rccx_run(args);
     EXPECT_EQ(r.exit_code, 2) << args << "\n" << r.out;
@@ -382,4 +508,5 @@ TEST(NetSecurityCli, BadArgumentsExitTwoAndWriteNothing) {
   EXPECT_EQ(help.exit_code, 0);
   EXPECT_NE(help.out.find("--participants"), std::string::npos) << help.out;
   EXPECT_NE(help.out.find("--force"), std::string::npos) << help.out;
+  EXPECT_NE(help.out.find("--protection"), std::string::npos) << help.out;
 }

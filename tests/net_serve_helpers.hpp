@@ -23,6 +23,7 @@
 
 #include "rccx/net/codec.hpp"
 #include "rccx/net/dds.hpp"
+#include "rccx/net/states.hpp"
 
 extern char** environ;
 
@@ -164,17 +165,13 @@ class StateRecorder {
       : participant_(loopback(d, detection)),
         reader_(participant_.reader(net::Topic::state, detection * 10)) {
     thread_ = std::thread([this] {
-      Record r;
-      void* ptrs[1] = {&r.state};
-      dds_sample_info_t info[1];
+      net::StateInbox in;
       while (!stop_) {
-        while (dds_take(reader_.get(), ptrs, info, 1, 1) == 1) {
-          if (!info[0].valid_data) continue;
-          r.received_ns = now_ns();
+        in.drain(reader_.get(), [&](const rccx_net_RobotState& s) {
           std::lock_guard lock(mutex_);
-          auto& v = records_[std::string(net::text_of(r.state.robot))];
-          if (v.empty() || v.back().state.sample != r.state.sample) v.push_back(r);
-        }
+          auto& v = records_[std::string(net::text_of(s.robot))];
+          if (v.empty() || v.back().state.sample != s.sample) v.push_back({s, now_ns()});
+        });
         std::this_thread::sleep_for(std::chrono::milliseconds(1));
       }
     });

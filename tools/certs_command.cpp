@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <set>
 #include <string>
@@ -26,6 +27,7 @@ struct CertsArgs {
   bool program = false;                   ///< add: --program (flag)
   int days = 365;
   bool force = false;
+  net::Protection protection = net::Protection::full;  ///< init: --protection
 };
 
 void check_name(const std::string& name) {
@@ -78,10 +80,12 @@ int run_init(const CertsArgs& a) {
   if (fs::exists(dir) && !fs::is_directory(dir)) {
     throw BadArgument{fmt::format("{} is not a directory", dir.string())};
   }
-  net::make_ca(dir, {.days = std::max(a.days, 3650), .force = a.force});
+  net::make_ca(dir, {.days = std::max(a.days, 3650), .force = a.force, .protection = a.protection});
   fmt::print(
-      "{}: identity_ca.pem, permissions_ca.pem, governance.p7s; the CAs' keys in {} (0700)\n",
-      dir.string(), (dir / "private").string());
+      "{}: identity_ca.pem, permissions_ca.pem, governance.p7s ({} protection); the CAs' keys in "
+      "{} (0700)\n",
+      dir.string(), a.protection == net::Protection::full ? "full" : "payload",
+      (dir / "private").string());
   const std::set<std::string> programs(a.programs.begin(), a.programs.end());
   for (const std::string& n : names) issue(dir, n, programs.count(n) > 0, a.days);
   fmt::print(
@@ -148,6 +152,16 @@ void add_certs_command(CLI::App& app, int& exit_code) {
       ->allow_extra_args(false);
   init->add_flag("--force", args->force,
                  "Replace DIR's CA (participants not issued again stop authenticating)");
+  init->add_option("--protection", args->protection,
+                   "full: every message, submessage and payload encrypted (ROS 2's sros2 "
+                   "default); payload: the payloads only, the headers clear (who talks to whom is "
+                   "seen, no data is read or forged), about half full's cost a round trip. Both "
+                   "authenticate and control access (docs/NETWORK.md, \"Security\")")
+      ->transform(CLI::CheckedTransformer(
+          std::map<std::string, net::Protection>{{"full", net::Protection::full},
+                                                 {"payload", net::Protection::payload}},
+          CLI::ignore_case))
+      ->default_str("full");
   CLI::App* add = certs->add_subcommand(
       "add", "Issues one more participant of DIR's CA (DIR/private/ holds the CAs' keys)");
   add->add_option("dir", args->dir, "The directory of rccx certs init")->required();

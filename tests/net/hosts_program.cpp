@@ -36,6 +36,7 @@
 #include "rccx/net/codec.hpp"
 #include "rccx/net/dds.hpp"
 #include "rccx/net/remote_cell.hpp"
+#include "rccx/net/states.hpp"
 
 namespace {
 
@@ -80,20 +81,18 @@ class StateReader {
   StateReader(const net::NetOptions& o, Track& track)
       : participant_(o), reader_(participant_.reader(net::Topic::state, o.detection * 10)) {
     thread_ = std::thread([this, &track] {
-      rccx_net_RobotState s{};
-      void* ptrs[1] = {&s};
-      dds_sample_info_t info[1];
+      net::StateInbox in;
       while (!stop_) {
-        while (dds_take(reader_.get(), ptrs, info, 1, 1) == 1) {
-          if (!info[0].valid_data) continue;
+        in.drain(reader_.get(), [&](const rccx_net_RobotState& s) {
           const std::string robot(net::text_of(s.robot));
           std::lock_guard lock(track.mutex);
           auto& last = track.last_sample[robot];
+          if (s.sample == last) return;  // the same state again (the serve's other robots' pass)
           if (last != 0 && s.sample > last + 1) track.gaps[robot] += s.sample - last - 1;
           last = std::max<std::uint64_t>(last, s.sample);
           ++track.samples[robot];
           track.tool[robot][s.stamp_ns] = net::from_pose(s.tool).p;
-        }
+        });
         std::this_thread::sleep_for(1ms);
       }
     });
@@ -334,19 +333,20 @@ int record(char** argv) {
   const net::Entity reader = participant.reader(net::Topic::state, o.detection * 10);
   std::printf("recording\n");
   std::fflush(stdout);
-  rccx_net_RobotState s{};
-  void* ptrs[1] = {&s};
-  dds_sample_info_t info[1];
+  net::StateInbox in;
+  std::map<std::string, std::uint64_t> last;  // by robot: its last sample written out
   while (!g_stop) {
-    while (dds_take(reader.get(), ptrs, info, 1, 1) == 1) {
-      if (!info[0].valid_data) continue;
+    in.drain(reader.get(), [&](const rccx_net_RobotState& s) {
+      std::uint64_t& seen = last[std::string(net::text_of(s.robot))];
+      if (s.sample == seen) return;  // the same state again (with the serve's other robots')
+      seen = s.sample;
       std::fprintf(out, "%s %llu %lld %lld %.9g %u", std::string(net::text_of(s.robot)).c_str(),
                    static_cast<unsigned long long>(s.sample), static_cast<long long>(s.stamp_ns),
                    static_cast<long long>(steady_ns()), s.period_s,
                    static_cast<unsigned>(s.status));
       for (std::size_t j = 0; j < s.dof; ++j) std::fprintf(out, " %.12g", s.q_commanded[j]);
       std::fprintf(out, "\n");
-    }
+    });
     std::fflush(out);
     std::this_thread::sleep_for(1ms);
   }

@@ -257,7 +257,8 @@ void check_participant_name(std::string_view name) {
   }
 }
 
-std::string governance_xml() {
+std::string governance_xml(Protection protection) {
+  const char* const headers = protection == Protection::full ? "ENCRYPT" : "NONE";
   // One domain rule for every domain rccx allows. Topic rules are taken in order, the first
   // that matches a topic's name applies: rccx's own topics fully protected; ROS 2's rt/* readable
   // by any authenticated participant (ROS 2 tools with their own certificates of this CA) but
@@ -272,10 +273,10 @@ std::string governance_xml() {
         "          <enable_liveliness_protection>true</enable_liveliness_protection>\n"
         "          <enable_read_access_control>{}</enable_read_access_control>\n"
         "          <enable_write_access_control>true</enable_write_access_control>\n"
-        "          <metadata_protection_kind>ENCRYPT</metadata_protection_kind>\n"
+        "          <metadata_protection_kind>{}</metadata_protection_kind>\n"
         "          <data_protection_kind>ENCRYPT</data_protection_kind>\n"
         "        </topic_rule>\n",
-        expression, read_controlled ? "true" : "false");
+        expression, read_controlled ? "true" : "false", headers);
   };
   rule("rccx_*", true);
   rule("rt/*", false);
@@ -292,14 +293,14 @@ std::string governance_xml() {
       "      <enable_join_access_control>true</enable_join_access_control>\n"
       "      <discovery_protection_kind>ENCRYPT</discovery_protection_kind>\n"
       "      <liveliness_protection_kind>ENCRYPT</liveliness_protection_kind>\n"
-      "      <rtps_protection_kind>ENCRYPT</rtps_protection_kind>\n"
+      "      <rtps_protection_kind>{}</rtps_protection_kind>\n"
       "      <topic_access_rules>\n"
       "{}"
       "      </topic_access_rules>\n"
       "    </domain_rule>\n"
       "  </domain_access_rules>\n"
       "</dds>\n",
-      topics);
+      headers, topics);
 }
 
 std::string permissions_xml(const std::string& subject, const Grants& grants,
@@ -369,7 +370,7 @@ void make_ca(const fs::path& dir, const CaOptions& options) {
   const Cert permissions = make_cert(permissions_key.get(), {"rccx permissions CA", ""}, nullptr,
                                      permissions_key.get(), true, from, to);
   const std::string governance =
-      smime_signed(governance_xml(), permissions.get(), permissions_key.get());
+      smime_signed(governance_xml(options.protection), permissions.get(), permissions_key.get());
   write_file(dir / kIdentityCaKey, pem_of(identity_key.get()), 0600);
   write_file(dir / kPermissionsCaKey, pem_of(permissions_key.get()), 0600);
   write_file(dir / kIdentityCa, pem_of(identity.get()), 0644);

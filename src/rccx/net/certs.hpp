@@ -43,9 +43,24 @@ Grants serve_grants();
 /// The role a participant's name gives it: "program..." is a program, others serve processes.
 Role role_of(std::string_view name);
 
+/// How much of each message DDS Security protects: the governance's protection kinds. Both
+/// authenticate every participant, control who reads and writes each topic, and encrypt
+/// discovery, liveliness and every topic's data (AES-GCM: a payload changed on the way is
+/// refused).
+enum class Protection : std::uint8_t {
+  /// Also every RTPS message and every submessage encrypted (sequence numbers, heartbeats,
+  /// acknowledgements): ROS 2's sros2 default. About 3x a plain round trip (docs/PERFORMANCE.md).
+  full,
+  /// The payloads only: the messages' and submessages' headers stay clear, so someone on the
+  /// network sees who talks to whom and when, and could disturb reliable delivery (a denial of
+  /// service), but reads and forges no data. About 1.4x a plain round trip.
+  payload,
+};
+
 struct CaOptions {
   int days = 3650;     ///< the CAs' validity, days from now
   bool force = false;  ///< replace the CA of DIR (every participant of it must be issued again)
+  Protection protection = Protection::full;  ///< the governance's
 };
 
 /// Makes DIR's identity CA and permissions CA (EC P-256, self-signed X.509 v3), their keys in
@@ -78,7 +93,7 @@ void issue_participant(const std::filesystem::path& dir, const std::string& name
 void check_participant_name(std::string_view name);
 
 /// The governance document (DDS Security 1.1) rccx uses; docs/NETWORK.md explains it.
-std::string governance_xml();
+std::string governance_xml(Protection protection = Protection::full);
 /// The permissions document of the participant whose certificate subject is `subject`
 /// ("/O=rccx/CN=puma", as OpenSSL writes it on one line), valid from `from` to `to`.
 std::string permissions_xml(const std::string& subject, const Grants& grants,

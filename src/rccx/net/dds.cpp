@@ -44,7 +44,7 @@ namespace {
 constexpr std::array kTopics{
     std::pair{kHeartbeatTopic, &rccx_net_Heartbeat_desc},
     std::pair{kClaimTopic, &rccx_net_Claim_desc},
-    std::pair{kStateTopic, &rccx_net_RobotState_desc},
+    std::pair{kStateTopic, &rccx_net_ServeStates_desc},
     std::pair{kRequestTopic, &rccx_net_MotionRequest_desc},
     std::pair{kAckTopic, &rccx_net_MotionAck_desc},
     std::pair{kEventTopic, &rccx_net_MotionEvent_desc},

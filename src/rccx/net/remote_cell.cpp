@@ -13,6 +13,7 @@
 
 #include "rccx/io/console.hpp"
 #include "rccx/net/codec.hpp"
+#include "rccx/net/states.hpp"
 
 namespace rccx::net {
 
@@ -411,6 +412,7 @@ RemoteCell::RemoteCell(cell::CellModel model, NetOptions net, RemoteOptions opti
   request_writer_ = participant_->writer(Topic::request);
   frame_writer_ = participant_->writer(Topic::frame);
   state_reader_ = participant_->reader(Topic::state, net_.detection * 10);
+  states_in_ = std::make_unique<StateInbox>();
   ack_reader_ = participant_->reader(Topic::ack);
   event_reader_ = participant_->reader(Topic::event);
   waitset_ = Entity(check(dds_create_waitset(participant_->get()), "a waitset"));
@@ -628,38 +630,32 @@ void RemoteCell::poll(std::int64_t now) {
   }
   bool changed = false;
   {
-    Inbox<rccx_net_RobotState> in(8);
-    for (;;) {
-      const int n = in.take(state_reader_.get());
-      for (int i = 0; i < n; ++i) {
-        if (!in.valid(i)) continue;
-        RemoteArm* a = find(text_of(in[i].robot));
-        if (a == nullptr) continue;
-        std::lock_guard lock(mutex_);
-        const bool restarted = a->mirror_->apply(in[i], now);
-        a->state_ = in[i];
-        a->state_received_ns_ = now;
-        if (!a->lost_.empty() || restarted) {
-          io::eprint("rccx program: robot {} is served {}by {}\n", a->name(),
-                     restarted ? "by a new serve process: " : "again ", text_of(in[i].participant));
-          a->lost_.clear();
-          a->mirror_->set_lost(false);
-        }
-        // Control ended on the serve (an overrun, a fault): the waits that now fail say why.
-        // A new serve, or control running again (restarted after an overrun): a later end is
-        // a new failure.
-        if (restarted || in[i].terminate_code == 0) a->end_said_ = false;
-        if (in[i].terminate_code != 0 && !a->end_said_) {
-          a->end_said_ = true;
-          const std::string why = fmt::format("robot {}'s control ended on its serve process: {}",
-                                              a->name(), text_of(in[i].termination));
-          a->failures_.push_back(lost_event(a->last_queued_, why));
-          io::eprint("rccx program: {}\n", why);
-        }
-        changed = true;
+    states_in_->drain(state_reader_.get(), [&](const rccx_net_RobotState& s) {
+      RemoteArm* a = find(text_of(s.robot));
+      if (a == nullptr) return;
+      std::lock_guard lock(mutex_);
+      const bool restarted = a->mirror_->apply(s, now);
+      a->state_ = s;
+      a->state_received_ns_ = now;
+      if (!a->lost_.empty() || restarted) {
+        io::eprint("rccx program: robot {} is served {}by {}\n", a->name(),
+                   restarted ? "by a new serve process: " : "again ", text_of(s.participant));
+        a->lost_.clear();
+        a->mirror_->set_lost(false);
       }
-      if (n < in.capacity()) break;
-    }
+      // Control ended on the serve (an overrun, a fault): the waits that now fail say why.
+      // A new serve, or control running again (restarted after an overrun): a later end is
+      // a new failure.
+      if (restarted || s.terminate_code == 0) a->end_said_ = false;
+      if (s.terminate_code != 0 && !a->end_said_) {
+        a->end_said_ = true;
+        const std::string why = fmt::format("robot {}'s control ended on its serve process: {}",
+                                            a->name(), text_of(s.termination));
+        a->failures_.push_back(lost_event(a->last_queued_, why));
+        io::eprint("rccx program: {}\n", why);
+      }
+      changed = true;
+    });
   }
   {
     Inbox<rccx_net_MotionEvent> in(16);

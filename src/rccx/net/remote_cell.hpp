@@ -42,6 +42,8 @@
 
 namespace rccx::net {
 
+class StateInbox;
+
 class RemoteCell;
 
 /// A robot's newest state as its serve process sent it.
@@ -235,6 +237,7 @@ class RemoteCell : public cell::Workcell {
   std::uint64_t instance_ = 0;
   std::unique_ptr<Participant> participant_;
   Entity hb_writer_, request_writer_, frame_writer_, state_reader_, ack_reader_, event_reader_;
+  std::unique_ptr<StateInbox> states_in_;  ///< made once: room for 2 samples of 256 states
   std::vector<std::unique_ptr<RemoteArm>> arms_;
   std::map<std::string, std::unique_ptr<FrameStream>> streams_;
 

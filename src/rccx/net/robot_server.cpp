@@ -17,6 +17,7 @@
 #include "rccx/io/console.hpp"
 #include "rccx/net/codec.hpp"
 #include "rccx/net/ros2_joint_state.hpp"
+#include "rccx/net/states.hpp"
 #include "rccx/rtc/latest.hpp"
 
 namespace rccx::net {
@@ -62,6 +63,7 @@ struct RobotServer::Local {
   // Middleware thread only.
   Slot slot;
   bool have_slot = false;
+  bool fresh = false;           ///< a new sample this pass
   std::int64_t written_ns = 0;  ///< steady, last state written
   bool end_said = false;        ///< its control's end was said on stderr
   std::uint64_t restarts = 0;   ///< control restarted after overruns
@@ -85,7 +87,7 @@ struct RobotServer::Local {
 /// thread allocates no take buffers).
 struct RobotServer::Inboxes {
   Inbox<rccx_net_Heartbeat> heartbeats{16};
-  Inbox<rccx_net_RobotState> states{8};
+  StateInbox states{4};
   Inbox<rccx_net_FrameSample> frames{8};
   Inbox<rccx_net_MotionRequest> requests{4};
 };
@@ -302,6 +304,7 @@ void RobotServer::start() {
       }
       locals_.push_back(std::move(l));
     }
+    states_out_ = std::make_unique<StateBatch>(participant_name_, instance_, locals_.size());
     for (const auto& r : full_model_.robots) {
       if (local(r.name) == nullptr) mirrors_[r.name] = std::make_unique<RobotMirror>(r.name);
     }
@@ -536,23 +539,17 @@ void RobotServer::read_heartbeats(std::int64_t now) {
 }
 
 void RobotServer::read_states(std::int64_t now) {
-  auto& in = inboxes_->states;
-  for (;;) {
-    const int n = in.take(state_reader_.get());
-    for (int i = 0; i < n; ++i) {
-      if (!in.valid(i)) continue;
-      const auto it = mirrors_.find(std::string(text_of(in[i].robot)));
-      if (it == mirrors_.end()) continue;  // ours (or not of this cell)
-      RobotMirror& m = *it->second;
-      const bool was_lost = m.lost();
-      if (m.apply(in[i], now) || was_lost) {
-        io::eprint("rccx serve: robot {} is served by {}{}\n", m.name(), m.participant(),
-                   was_lost ? " again" : " (a new instance)");
-      }
-      if (was_lost) m.set_lost(false);
+  inboxes_->states.drain(state_reader_.get(), [&](const rccx_net_RobotState& s) {
+    const auto it = mirrors_.find(std::string(text_of(s.robot)));
+    if (it == mirrors_.end()) return;  // ours (or not of this cell)
+    RobotMirror& m = *it->second;
+    const bool was_lost = m.lost();
+    if (m.apply(s, now) || was_lost) {
+      io::eprint("rccx serve: robot {} is served by {}{}\n", m.name(), m.participant(),
+                 was_lost ? " again" : " (a new instance)");
     }
-    if (n < in.capacity()) break;
-  }
+    if (was_lost) m.set_lost(false);
+  });
 }
 
 void RobotServer::read_frames(std::int64_t now) {
@@ -839,22 +836,31 @@ void RobotServer::publish_events() {
 }
 
 void RobotServer::publish_states(std::int64_t now, bool last) {
+  // One sample for all the robots (ServeStates), when one of them has a fresh sample, or the
+  // last one again every heartbeat period: a robot sampled more slowly than the detection time
+  // (the Microbo's 28 ms) still shows it is alive. Every robot is in it with its newest state, so
+  // a reader that keeps the last sample only still has each robot's newest.
+  bool due = last;
   for (auto& lp : locals_) {
     Local& l = *lp;
-    const bool fresh = l.latest.take(l.slot);
-    l.have_slot = l.have_slot || fresh;
-    // A fresh sample, or the last one again every heartbeat period: a robot sampled more
-    // slowly than the detection time (the Microbo's 28 ms) still shows it is alive.
-    if (!fresh && !last && now - l.written_ns < options_.net.heartbeat.count()) continue;
+    l.fresh = l.latest.take(l.slot);
+    l.have_slot = l.have_slot || l.fresh;
+    due = due || (l.have_slot && (l.fresh || now - l.written_ns >= options_.net.heartbeat.count()));
+  }
+  if (!due) return;
+  const std::int64_t written_ns = wall_ns();
+  for (auto& lp : locals_) {
+    Local& l = *lp;
     if (!l.have_slot) continue;
-    rccx_net_RobotState s{};
+    const bool fresh = l.fresh;
+    rccx_net_RobotState& s = states_out_->add();
     copy_to(s.robot, l.name);
     copy_to(s.participant, participant_name_);
     s.instance = instance_;
     s.sample = l.slot.sample;
     s.t_s = l.slot.t_s;
     s.stamp_ns = l.slot.stamp_ns;
-    s.written_ns = wall_ns();
+    s.written_ns = written_ns;
     s.period_s = l.period_s;
     s.dof = l.slot.dof;
     for (std::size_t j = 0; j < l.slot.dof; ++j) {
@@ -906,7 +912,6 @@ void RobotServer::publish_states(std::int64_t now, bool last) {
     s.running = l.slot.running;
     s.queued = l.arm->last_queued();
     copy_to(s.program, l.program);
-    check(dds_write(state_writer_.get(), &s), "a robot state");
     l.written_ns = now;
     // ROS 2's view of each new state (not the heartbeat's repeats): the measured joints (ROS's
     // convention for joint_states), the commanded speeds, stamped when they were read (the
@@ -918,6 +923,7 @@ void RobotServer::publish_states(std::int64_t now, bool last) {
           s.dof == n ? std::span<const double>(s.qd_commanded, n) : std::span<const double>{});
     }
   }
+  check(states_out_->write(state_writer_.get()), "the robots' states");
 }
 
 void RobotServer::check_lost(std::int64_t now) {

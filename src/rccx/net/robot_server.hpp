@@ -42,6 +42,8 @@
 
 namespace rccx::net {
 
+class StateBatch;
+
 /// Another serve process holds a robot asked for (or won the race for it); the message names it.
 class ClaimRefused : public NetError {
  public:
@@ -164,6 +166,7 @@ class RobotServer {
   std::vector<rccx_net_Claim> claims_;
 
   std::vector<std::unique_ptr<Local>> locals_;
+  std::unique_ptr<StateBatch> states_out_;  ///< locals_' states, written a pass
   std::map<std::string, std::unique_ptr<RobotMirror>> mirrors_;  ///< the cell's other robots
   /// The other robots' newest joints for the collision check (cell::RemoteRobotSource).
   struct MirrorSource : cell::RemoteRobotSource {

@@ -6,7 +6,8 @@
 //   rccx_heartbeat        Heartbeat     best effort, keep last 1, liveliness automatic (lease =
 //                                       detection time); a peer silent that long is lost
 //   rccx_claim            Claim         reliable, transient local, keep last 1
-//   rccx_state            RobotState    best effort, keep last 1, deadline (3 periods + detection)
+//   rccx_state            ServeStates   best effort, keep last 1, deadline (the detection time):
+//                                       a serve's robots' RobotStates, one sample a pass
 //   rccx_request          MotionRequest reliable, keep all, volatile (ordered per writer)
 //   rccx_ack              MotionAck     reliable, keep last kAckDepth, never blocking the writer
 //   rccx_event            MotionEvent   reliable, keep last kEventDepth, never blocking the writer
