@@ -64,6 +64,8 @@ struct RobotServer::Local {
   Slot slot;
   bool have_slot = false;
   bool fresh = false;           ///< a new sample this pass
+  std::size_t batch_index = 0;  ///< its state's place in states_out_ this pass
+  bool ros2_due = false;        ///< its ROS 2 joint state to send this pass
   std::int64_t written_ns = 0;  ///< steady, last state written
   bool end_said = false;        ///< its control's end was said on stderr
   std::uint64_t restarts = 0;   ///< control restarted after overruns
@@ -388,6 +390,7 @@ void RobotServer::run() noexcept {
         poll();
         wake_at = next_wake();
       }
+      send_states();
       // No spinning: a request comes seldom, and a tick's ring wakes the futex directly.
       rtc::detail::wait_while(wake_, seen, wake_at, 0);
     }
@@ -403,12 +406,14 @@ void RobotServer::run() noexcept {
       }
       publish_events();
       publish_states(steady_ns());
+      send_states();
       if (rest) break;
       std::this_thread::sleep_for(1ms);
     }
     std::this_thread::sleep_for(100ms);  // the halt's last samples
     publish_events();
     publish_states(steady_ns(), true);
+    send_states();
   } catch (const std::exception& e) {
     std::lock_guard lock(failure_mutex_);
     failure_ = e.what();
@@ -428,15 +433,7 @@ void RobotServer::poll() {
   publish_states(now);
   restart_after_overruns();
   if (now - last_heartbeat_ns_ >= options_.net.heartbeat.count()) {
-    rccx_net_Heartbeat hb{};
-    copy_to(hb.participant, participant_name_);
-    hb.role = static_cast<std::uint8_t>(Role::serve);
-    hb.instance = instance_;
-    hb.seq = ++heartbeat_seq_;
-    hb.period_ns = options_.net.heartbeat.count();
-    hb.detection_ns = options_.net.detection.count();
-    copy_to(hb.robots, join(robot_names_));
-    check(dds_write(hb_writer_.get(), &hb), "a heartbeat");
+    heartbeat_due_ = true;  // written by send_states()
     last_heartbeat_ns_ = now;
   }
   check_lost(now);
@@ -913,15 +910,36 @@ void RobotServer::publish_states(std::int64_t now, bool last) {
     s.queued = l.arm->last_queued();
     copy_to(s.program, l.program);
     l.written_ns = now;
+    l.batch_index = states_out_->size() - 1;
     // ROS 2's view of each new state (not the heartbeat's repeats): the measured joints (ROS's
     // convention for joint_states), the commanded speeds, stamped when they were read (the
     // state's written_ns; its stamp_ns is the commanded setpoint's time, two periods ahead).
-    if (const std::size_t n = l.ros2 ? l.ros2->dof() : 0;
-        n != 0 && (fresh || last) && h.dof >= n && n <= std::size(s.q_measured)) {
-      l.ros2->publish(
-          s.written_ns, std::span<const double>(s.q_measured, n),
-          s.dof == n ? std::span<const double>(s.qd_commanded, n) : std::span<const double>{});
-    }
+    const std::size_t n = l.ros2 ? l.ros2->dof() : 0;
+    l.ros2_due = n != 0 && (fresh || last) && h.dof >= n && n <= std::size(s.q_measured);
+  }
+}
+
+void RobotServer::send_states() {
+  if (heartbeat_due_) {
+    heartbeat_due_ = false;
+    rccx_net_Heartbeat hb{};
+    copy_to(hb.participant, participant_name_);
+    hb.role = static_cast<std::uint8_t>(Role::serve);
+    hb.instance = instance_;
+    hb.seq = ++heartbeat_seq_;
+    hb.period_ns = options_.net.heartbeat.count();
+    hb.detection_ns = options_.net.detection.count();
+    copy_to(hb.robots, join(robot_names_));
+    check(dds_write(hb_writer_.get(), &hb), "a heartbeat");
+  }
+  for (auto& lp : locals_) {
+    Local& l = *lp;
+    if (!std::exchange(l.ros2_due, false)) continue;
+    const rccx_net_RobotState& s = (*states_out_)[l.batch_index];
+    const std::size_t n = l.ros2->dof();
+    l.ros2->publish(
+        s.written_ns, std::span<const double>(s.q_measured, n),
+        s.dof == n ? std::span<const double>(s.qd_commanded, n) : std::span<const double>{});
   }
   check(states_out_->write(state_writer_.get()), "the robots' states");
 }

@@ -124,7 +124,12 @@ class RobotServer {
   void publish_events();
   /// A robot whose control an overrun ended (said and published already) starts again at rest.
   void restart_after_overruns();
+  /// Fills the robots' states for send_states() (under serve_mutex_: it reads the arms).
   void publish_states(std::int64_t now, bool last = false);
+  /// Writes what publish_states() and poll() made ready: the states, the ROS 2 joint states, the
+  /// heartbeat. Outside serve_mutex_ in a pass: the request listener, which never makes these
+  /// writes, answers meanwhile instead of waiting for their system calls.
+  void send_states();
   void check_lost(std::int64_t now);
   /// When the middleware thread must run again with nothing arriving (steady ns): the next
   /// heartbeat, a state to repeat, a peer's loss deadline.
@@ -187,6 +192,7 @@ class RobotServer {
   bool stopped_ = false;
   std::int64_t last_heartbeat_ns_ = 0;
   std::uint64_t heartbeat_seq_ = 0;
+  bool heartbeat_due_ = false;  ///< poll() found a heartbeat due: send_states() writes it
   /// A request attached a program since the middleware thread's last pass (serve_mutex_).
   bool attached_since_pass_ = false;
   /// Samples of a reliable topic its writer could not take without waiting (a reader that

@@ -29,6 +29,10 @@ class StateBatch {
   /// The next robot's state to fill in, zeroed; at most capacity() a pass.
   rccx_net_RobotState& add() noexcept;
   [[nodiscard]] std::size_t size() const noexcept { return size_; }
+  /// The i-th state added this pass (i < size()).
+  [[nodiscard]] const rccx_net_RobotState& operator[](std::size_t i) const noexcept {
+    return states_[i];
+  }
   [[nodiscard]] std::size_t capacity() const noexcept { return states_.size(); }
   /// Writes the states added since the last write (nothing when none), then starts a new pass.
   /// Returns the first failed dds_write's code, else 0.
