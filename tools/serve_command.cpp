@@ -83,6 +83,7 @@ int run_serve(const ServeArgs& args) {
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
   server->stop();
+  fmt::print("rccx serve: the control clock, {}\n", server->clock_report());
   if (const std::string why = server->failure(); !why.empty()) {
     io::eprint("rccx serve: stopped on an error: {}\n", why);
     return kFailure;

@@ -413,6 +413,7 @@ RemoteCell::RemoteCell(cell::CellModel model, NetOptions net, RemoteOptions opti
   frame_writer_ = participant_->writer(Topic::frame);
   state_reader_ = participant_->reader(Topic::state, net_.detection * 10);
   states_in_ = std::make_unique<StateInbox>();
+  events_in_ = std::make_unique<Inbox<rccx_net_MotionEvent>>(16);
   ack_reader_ = participant_->reader(Topic::ack);
   event_reader_ = participant_->reader(Topic::event);
   waitset_ = Entity(check(dds_create_waitset(participant_->get()), "a waitset"));
@@ -658,7 +659,7 @@ void RemoteCell::poll(std::int64_t now) {
     });
   }
   {
-    Inbox<rccx_net_MotionEvent> in(16);
+    Inbox<rccx_net_MotionEvent>& in = *events_in_;
     for (;;) {
       const int n = in.take(event_reader_.get());
       for (int i = 0; i < n; ++i) {

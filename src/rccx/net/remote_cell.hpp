@@ -43,6 +43,10 @@
 namespace rccx::net {
 
 class StateInbox;
+namespace detail {
+template <class T>
+class Inbox;
+}  // namespace detail
 
 class RemoteCell;
 
@@ -238,6 +242,7 @@ class RemoteCell : public cell::Workcell {
   std::unique_ptr<Participant> participant_;
   Entity hb_writer_, request_writer_, frame_writer_, state_reader_, ack_reader_, event_reader_;
   std::unique_ptr<StateInbox> states_in_;  ///< made once: room for 2 samples of 256 states
+  std::unique_ptr<detail::Inbox<rccx_net_MotionEvent>> events_in_;  ///< made once
   std::vector<std::unique_ptr<RemoteArm>> arms_;
   std::map<std::string, std::unique_ptr<FrameStream>> streams_;
 

@@ -48,6 +48,18 @@ std::string join(const std::vector<std::string>& v) {
   return s;
 }
 
+/// The serve's clock so far: whether an overrun came from a late wake-up (the machine) or a
+/// long cycle (the control functions) is the first thing to know about it.
+std::string clock_figures(const rtc::Session& session, std::chrono::nanoseconds period) {
+  const rtc::LatencyStats wake = session.latency();
+  const rtc::LatencyStats cycle = session.compute();
+  return fmt::format(
+      "{} ticks of {:.3g} ms: cycle p50 {:.0f} us, p99 {:.0f} us, max {:.0f} us; wake-up p99 "
+      "{:.0f} us, max {:.0f} us late; {} deadlines missed",
+      cycle.wakeups, std::chrono::duration<double, std::milli>(period).count(), cycle.p50_us,
+      cycle.p99_us, cycle.max_us, wake.p99_us, wake.max_us, wake.missed_deadlines);
+}
+
 }  // namespace
 
 struct RobotServer::Local {
@@ -338,7 +350,13 @@ void RobotServer::stop() {
     answering_.store(false);
   }
   release_claims();
+  clock_report_ = clock_report();
   cell_.reset();  // ends control
+}
+
+std::string RobotServer::clock_report() const {
+  if (!cell_ || locals_.empty()) return clock_report_;
+  return clock_figures(*locals_.front()->session, cell_->group().period());
 }
 
 // --- The control task's part -----------------------------------------------------------------
@@ -849,7 +867,6 @@ void RobotServer::publish_states(std::int64_t now, bool last) {
   for (auto& lp : locals_) {
     Local& l = *lp;
     if (!l.have_slot) continue;
-    const bool fresh = l.fresh;
     rccx_net_RobotState& s = states_out_->add();
     copy_to(s.robot, l.name);
     copy_to(s.participant, participant_name_);
@@ -898,6 +915,10 @@ void RobotServer::publish_states(std::int64_t now, bool last) {
         l.end_said = true;
         io::eprint("rccx serve: robot {}'s control ended: {}{}{}\n", l.name, rtc::describe(code),
                    why.empty() ? "" : ": ", why);
+        if (code == rtc::TerminateCode::overrun) {
+          io::eprint("rccx serve: robot {}'s clock until then: {}\n", l.name,
+                     clock_figures(*l.session, cell_->group().period()));
+        }
       }
     } else if (last) {
       s.status = static_cast<std::uint8_t>(RobotStatus::ended);
@@ -915,7 +936,7 @@ void RobotServer::publish_states(std::int64_t now, bool last) {
     // convention for joint_states), the commanded speeds, stamped when they were read (the
     // state's written_ns; its stamp_ns is the commanded setpoint's time, two periods ahead).
     const std::size_t n = l.ros2 ? l.ros2->dof() : 0;
-    l.ros2_due = n != 0 && (fresh || last) && h.dof >= n && n <= std::size(s.q_measured);
+    l.ros2_due = n != 0 && (l.fresh || last) && h.dof >= n && n <= std::size(s.q_measured);
   }
 }
 

@@ -94,6 +94,9 @@ class RobotServer {
   /// Set when the middleware thread stopped on an error (what went wrong); "" while all is well.
   [[nodiscard]] std::string failure() const;
   [[nodiscard]] cell::Cell& cell() noexcept { return *cell_; }
+  /// The control clock's figures so far (after stop(): until then): ticks, the cycle's
+  /// computing time and the wake-up latency (us), deadlines missed.
+  [[nodiscard]] std::string clock_report() const;
 
  private:
   struct Local;
@@ -183,6 +186,7 @@ class RobotServer {
   std::map<std::string, std::unique_ptr<Stream>> streams_;
   /// After what its cycle observer, remote source and streams read: it (its tasks) goes first.
   std::unique_ptr<cell::Cell> cell_;
+  std::string clock_report_;  ///< kept by stop() for clock_report()
   std::map<std::string, Program> programs_;
   std::map<std::string, std::unique_ptr<Dedup>> dedup_;  ///< by "<program>|<robot>"
 

@@ -1,6 +1,7 @@
 #include "rccx/net/states.hpp"
 
 #include <algorithm>
+#include <cassert>
 
 #include "rccx/net/dds.hpp"
 
@@ -23,6 +24,7 @@ StateBatch::StateBatch(std::string_view participant, std::uint64_t instance, std
 }
 
 rccx_net_RobotState& StateBatch::add() noexcept {
+  assert(size_ < states_.size() && "StateBatch::add: more robots than the batch was made for");
   rccx_net_RobotState& s = states_[std::min(size_, states_.size() - 1)];
   size_ = std::min(size_ + 1, states_.size());
   s = rccx_net_RobotState{};

@@ -238,6 +238,10 @@ LatencyStats Session::latency() const {
   return clock_->latency();
 }
 
+LatencyStats Session::compute() const {
+  return clock_->compute();
+}
+
 void Session::set_tap(SampleTap* tap) noexcept {
   channel_->set_tap(tap);
 }

@@ -201,6 +201,8 @@ class Session {
   void set_tap(SampleTap* tap) noexcept;
   /// Wake-up latency of the communication task (real time only).
   [[nodiscard]] LatencyStats latency() const;
+  /// Computing time of each tick (SessionGroup::compute(): the clock's, shared by its robots).
+  [[nodiscard]] LatencyStats compute() const;
 
   /// user_hangup: replaces what Ctrl-C does during control (default: terminate with
   /// user_interrupt). Runs on a helper thread, not in the sample loop.
