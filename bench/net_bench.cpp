@@ -39,7 +39,10 @@
 // "puma" in the child and the serve), RCCX_BENCH_SERVE_OPTIONS (more options for the serve, a
 // diagnosis: "--no-ros2").
 // Diagnoses: RCCX_BENCH_LISTENER=1 (the responder answers from a listener, in Cyclone's receive
-// thread), RCCX_BENCH_KEEP_LAST=1 (request and ack reliable keep last 1, as ddsperf's ping/pong).
+// thread), RCCX_BENCH_KEEP_LAST=1 (request and ack reliable keep last 1, as ddsperf's ping/pong;
+// 2: the readers only, 3: the writers only), RCCX_BENCH_DUMP=FILE (BM_ServeRequestAckWireListener
+// writes each measured round trip there, "start_ns round_trip_ns" a line, start on
+// CLOCK_MONOTONIC as the serve's ticks: scripts/roundtrip-phases finds which of them were slow).
 #include <benchmark/benchmark.h>
 #include <fcntl.h>
 #include <signal.h>
@@ -226,9 +229,13 @@ net::Entity keep_last_1_writer(const net::Participant& p, net::Topic t) {
 }
 
 /// A reader / writer of `t` with the topic's QoS, or, with RCCX_BENCH_KEEP_LAST=1 (a diagnosis:
-/// what keep-all costs), reliable keep last 1 as ddsperf's ping/pong.
+/// what keep-all costs), reliable keep last 1 as ddsperf's ping/pong (2: the readers only, 3:
+/// the writers only).
 net::Entity endpoint(const net::Participant& p, net::Topic t, bool writer) {
-  if (env_long("RCCX_BENCH_KEEP_LAST", 0) == 0) return writer ? p.writer(t) : p.reader(t);
+  const long keep_last = env_long("RCCX_BENCH_KEEP_LAST", 0);
+  const bool mine =
+      writer ? (keep_last == 1 || keep_last == 3) : (keep_last == 1 || keep_last == 2);
+  if (!mine) return writer ? p.writer(t) : p.reader(t);
   if (writer) return keep_last_1_writer(p, t);
   const net::Qos qos;
   dds_qset_reliability(qos.get(), DDS_RELIABILITY_RELIABLE, DDS_MSECS(100));
@@ -629,7 +636,7 @@ void BM_ServeRequestAckWireListener(benchmark::State& state) {
     WireProgram* w = nullptr;
     long total = 0;
     long warmup = 2000;
-    std::vector<std::int64_t> ns;
+    std::vector<std::int64_t> ns, at;
     std::chrono::steady_clock::time_point t0;
     std::atomic<long> sent{0};  // the request in flight
     std::atomic<bool> done{false};
@@ -643,7 +650,10 @@ void BM_ServeRequestAckWireListener(benchmark::State& state) {
     void on_acks() {  // Cyclone's receive thread
       const long i = sent.load();
       if (done.load() || !w->take_ack(static_cast<std::uint64_t>(i))) return;
-      if (i > warmup) ns.push_back((std::chrono::steady_clock::now() - t0).count());
+      if (i > warmup) {
+        ns.push_back((std::chrono::steady_clock::now() - t0).count());
+        at.push_back(t0.time_since_epoch().count());
+      }
       if (i < total) {
         send();
       } else {
@@ -661,6 +671,7 @@ void BM_ServeRequestAckWireListener(benchmark::State& state) {
     ping.w = &w;
     ping.total = ping.warmup + roundtrips;
     ping.ns.reserve(static_cast<std::size_t>(roundtrips));
+    ping.at.reserve(static_cast<std::size_t>(roundtrips));
     dds_listener_t* l = dds_create_listener(&ping);
     dds_lset_data_available(l,
                             [](dds_entity_t, void* arg) { static_cast<Pinger*>(arg)->on_acks(); });
@@ -687,6 +698,15 @@ void BM_ServeRequestAckWireListener(benchmark::State& state) {
     if (!failed.empty()) {
       state.SkipWithError(failed.c_str());
       return;
+    }
+    if (const char* dump = std::getenv("RCCX_BENCH_DUMP"); dump != nullptr) {
+      if (FILE* f = std::fopen(dump, "w"); f != nullptr) {
+        for (std::size_t k = 0; k < ping.ns.size(); ++k) {
+          std::fprintf(f, "%lld %lld\n", static_cast<long long>(ping.at[k]),
+                       static_cast<long long>(ping.ns[k]));
+        }
+        std::fclose(f);
+      }
     }
     set_latency_counters(state, ping.ns);
     (void)w.serve->terminate(5s);
