@@ -54,6 +54,7 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <cerrno>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -700,12 +701,19 @@ void BM_ServeRequestAckWireListener(benchmark::State& state) {
       return;
     }
     if (const char* dump = std::getenv("RCCX_BENCH_DUMP"); dump != nullptr) {
-      if (FILE* f = std::fopen(dump, "w"); f != nullptr) {
-        for (std::size_t k = 0; k < ping.ns.size(); ++k) {
-          std::fprintf(f, "%lld %lld\n", static_cast<long long>(ping.at[k]),
-                       static_cast<long long>(ping.ns[k]));
-        }
-        std::fclose(f);
+      FILE* f = std::fopen(dump, "w");
+      bool written = f != nullptr;
+      for (std::size_t k = 0; written && k < ping.ns.size(); ++k) {
+        written = std::fprintf(f, "%lld %lld\n", static_cast<long long>(ping.at[k]),
+                               static_cast<long long>(ping.ns[k])) > 0;
+      }
+      if (f != nullptr) written = std::fclose(f) == 0 && written;
+      if (!written) {
+        const std::string why = std::string("RCCX_BENCH_DUMP: could not write ") + dump + ": " +
+                                std::strerror(errno) + " (give a writable file)";
+        state.SkipWithError(why.c_str());
+        (void)w.serve->terminate(5s);
+        return;
       }
     }
     set_latency_counters(state, ping.ns);
