@@ -1,9 +1,13 @@
 // Positions and settings on the wire (src/rccx/net/codec.hpp): every term kind crosses and
 // comes back as the same equation; what cannot cross is refused saying how to name it.
+#include <dds/dds.h>
+#include <dds/ddsi/ddsi_cdrstream.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <string>
+#include <vector>
 
 #include "rccx/net/codec.hpp"
 #include "rccx/rccl/transforms.hpp"
@@ -29,6 +33,27 @@ rccl::TransformPtr resolve(net::TermKind k, std::string_view name) {
   const double code = static_cast<double>(k);
   return rccl::constant(std::string(name) + "_resolved", pose(code, 0, 0, 0));
 }
+
+/// `r` through Cyclone's own CDR (what crosses the wire) and back into a sample Cyclone fills
+/// as a reader's take does (its sequences allocated by Cyclone, freed here).
+struct Wire {
+  std::vector<unsigned char> bytes;
+  rccx_net_MotionRequest back{};
+  explicit Wire(const rccx_net_MotionRequest& r) {
+    dds_ostream_t os;
+    dds_ostream_init(&os, 0, 1);  // XCDR1: the types are final
+    (void)dds_stream_write(&os, reinterpret_cast<const char*>(&r),
+                           rccx_net_MotionRequest_desc.m_ops);
+    bytes.assign(os.m_buffer, os.m_buffer + os.m_index);
+    dds_ostream_fini(&os);
+    dds_istream_t is;
+    dds_istream_init(&is, static_cast<std::uint32_t>(bytes.size()), bytes.data(), 1);
+    (void)dds_stream_read(&is, reinterpret_cast<char*>(&back), rccx_net_MotionRequest_desc.m_ops);
+  }
+  ~Wire() { dds_sample_free(&back, &rccx_net_MotionRequest_desc, DDS_FREE_CONTENTS); }
+  Wire(const Wire&) = delete;
+  Wire& operator=(const Wire&) = delete;
+};
 
 }  // namespace
 
@@ -57,20 +82,23 @@ TEST(NetCodec, EveryTermKindCrossesAndTheEquationIsTheSame) {
   cam->set_reference("stream:camera");
   const auto p =
       rccl::Position::make("GOAL", {base, rccl::t6(), tool, grip}, {leader, conv, cam}, tool);
-  rccx_net_MotionRequest r{};
-  net::encode_position(*p, r);
-  EXPECT_EQ(r.lhs_count, 4);
-  EXPECT_EQ(r.rhs_count, 3);
+  net::RequestSample sample;
+  net::encode_position(*p, sample);
+  // Through the wire's bytes: what the serve decodes is what Cyclone deserialized.
+  const Wire wire(sample.msg);
+  const rccx_net_MotionRequest& r = wire.back;
+  ASSERT_EQ(r.lhs._length, 4U);
+  ASSERT_EQ(r.rhs._length, 3U);
   EXPECT_EQ(r.tool, 2);
-  EXPECT_EQ(r.lhs[0].kind, static_cast<std::uint8_t>(net::TermKind::constant));
-  EXPECT_EQ(r.lhs[1].kind, static_cast<std::uint8_t>(net::TermKind::t6));
-  EXPECT_EQ(r.lhs[3].kind, static_cast<std::uint8_t>(net::TermKind::hold));
-  EXPECT_EQ(r.rhs[0].kind, static_cast<std::uint8_t>(net::TermKind::frame));
-  EXPECT_STREQ(r.rhs[0].name, "puma");
-  EXPECT_EQ(r.rhs[1].kind, static_cast<std::uint8_t>(net::TermKind::function));
-  EXPECT_STREQ(r.rhs[1].name, "conveyor");
-  EXPECT_EQ(r.rhs[2].kind, static_cast<std::uint8_t>(net::TermKind::stream));
-  EXPECT_STREQ(r.rhs[2].name, "camera");
+  EXPECT_EQ(r.lhs._buffer[0].kind, static_cast<std::uint8_t>(net::TermKind::constant));
+  EXPECT_EQ(r.lhs._buffer[1].kind, static_cast<std::uint8_t>(net::TermKind::t6));
+  EXPECT_EQ(r.lhs._buffer[3].kind, static_cast<std::uint8_t>(net::TermKind::hold));
+  EXPECT_EQ(r.rhs._buffer[0].kind, static_cast<std::uint8_t>(net::TermKind::frame));
+  EXPECT_STREQ(r.rhs._buffer[0].name, "puma");
+  EXPECT_EQ(r.rhs._buffer[1].kind, static_cast<std::uint8_t>(net::TermKind::function));
+  EXPECT_STREQ(r.rhs._buffer[1].name, "conveyor");
+  EXPECT_EQ(r.rhs._buffer[2].kind, static_cast<std::uint8_t>(net::TermKind::stream));
+  EXPECT_STREQ(r.rhs._buffer[2].name, "camera");
 
   const auto back = net::decode_position(r, resolve);
   EXPECT_EQ(back->name(), "GOAL");
@@ -96,17 +124,19 @@ TEST(NetCodec, AHoldCrossesWithTheValueItHasWhenSent) {
   auto h = rccl::hold("H", pose(0.1, 0.1, 0.1, 0));
   const auto p = rccl::Position::make("P", {rccl::t6()}, {h});
   h->set(pose(0.2, 0.2, 0.2, 0.5));
-  rccx_net_MotionRequest r{};
+  net::RequestSample r;
   net::encode_position(*p, r);
-  const auto back = net::decode_position(r, resolve);
+  const Wire wire(r.msg);
+  const auto back = net::decode_position(wire.back, resolve);
   EXPECT_EQ(distance(back->rhs()[0]->value(), pose(0.2, 0.2, 0.2, 0.5)), 0.0);
 }
 
 TEST(NetCodec, AJointPositionRoundTrips) {
   const auto p = rccl::Position::joints("park", kin::JointVector{0.1, -0.2, 0.3, 0, 0.5, -0.6});
-  rccx_net_MotionRequest r{};
+  net::RequestSample r;
   net::encode_position(*p, r);
-  const auto back = net::decode_position(r, resolve);
+  const Wire wire(r.msg);
+  const auto back = net::decode_position(wire.back, resolve);
   ASSERT_TRUE(back->in_joints());
   ASSERT_EQ(back->joint_values().size(), 6U);
   for (std::size_t j = 0; j < 6; ++j) EXPECT_EQ(back->joint_values()[j], p->joint_values()[j]);
@@ -116,8 +146,8 @@ TEST(NetCodec, AFunctionalTransformWithoutANameIsRefusedSayingHowToNameIt) {
   auto f = rccl::functional("WOBBLE",
                             [](const rccl::SampleContext&) { return math::Transform::identity(); });
   const auto p = rccl::Position::make("P", {rccl::t6()}, {f});
-  rccx_net_MotionRequest r{};
-  r.lhs_count = 7;  // bad input changes nothing
+  net::RequestSample r;
+  r.add_lhs().kind = 42;  // bad input changes nothing
   try {
     net::encode_position(*p, r);
     FAIL() << "an unnamed functional transform was encoded";
@@ -127,7 +157,8 @@ TEST(NetCodec, AFunctionalTransformWithoutANameIsRefusedSayingHowToNameIt) {
     EXPECT_NE(m.find("set_reference(\"function:"), std::string::npos) << m;
     EXPECT_NE(m.find("tool_frame"), std::string::npos) << m;
   }
-  EXPECT_EQ(r.lhs_count, 7);
+  ASSERT_EQ(r.msg.lhs._length, 1U);
+  EXPECT_EQ(r.msg.lhs._buffer[0].kind, 42);
   f->set_reference("gizmo:x");
   EXPECT_THROW(net::encode_position(*p, r), net::CodecError);
 }
@@ -163,4 +194,40 @@ TEST(NetCodec, SettingsRoundTrip) {
   EXPECT_EQ(b.compliance.force[2], 3.0);
   EXPECT_EQ(b.compliance.max_offset_m, 0.01);
   EXPECT_EQ(b.may_touch, 6U);
+}
+
+TEST(NetCodec, ACopiedRequestOwnsItsTermsAndSendsOnlyThoseItHas) {
+  auto base = rccl::constant("BASE", pose(0.1, 0, 0, 0.3));
+  const auto p =
+      rccl::Position::make("P", {base, rccl::t6()}, {rccl::constant("OBJ", pose(0.4, 0, 0, 0))});
+  net::RequestSample a;
+  net::encode_position(*p, a);
+  const net::RequestSample b = a;  // RemoteArm re-sends a copy: its sequences must be its own
+  a.add_rhs().kind = 9;
+  EXPECT_NE(b.msg.lhs._buffer, a.msg.lhs._buffer);
+  EXPECT_EQ(b.msg.rhs._length, 1U);
+  EXPECT_STREQ(b.msg.rhs._buffer[0].name, "OBJ");
+  const Wire wire(b.msg);
+  EXPECT_EQ(wire.back.rhs._length, 1U);
+  EXPECT_STREQ(wire.back.lhs._buffer[0].name, "BASE");
+
+  // On the wire, a request carries the terms it has: an attach (none) is a few hundred bytes,
+  // each term about 110 more (its pose). With the 8 + 8 terms and 4 gates as fixed arrays, every
+  // request was over 2 kB, whatever it carried.
+  const net::RequestSample attach;
+  const std::size_t empty = Wire(attach.msg).bytes.size();
+  const std::size_t two_and_one = wire.bytes.size();
+  EXPECT_LT(empty, 500U);
+  EXPECT_GT(two_and_one, empty + 2 * 100);  // BASE and OBJ carry their poses
+  EXPECT_LT(two_and_one, empty + 3 * 130);
+  std::printf("serialized: attach %zu B, 2 + 1 terms %zu B\n", empty, two_and_one);
+}
+
+TEST(NetCodec, AReceivedRequestWithATooLargeToolIndexIsRefused) {
+  net::RequestSample r;
+  const auto p =
+      rccl::Position::make("P", {rccl::t6()}, {rccl::constant("OBJ", pose(0.4, 0, 0, 0))});
+  net::encode_position(*p, r);
+  r.msg.tool = 1;  // lhs has one term
+  EXPECT_THROW((void)net::decode_position(Wire(r.msg).back, resolve), net::CodecError);
 }

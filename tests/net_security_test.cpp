@@ -154,7 +154,8 @@ Exchange run_exchange(std::vector<Peer>& peers, double seconds = 6.0,
     while (dds_take(requests.get(), samples, info, 1, 1) == 1) {
       if (info[0].valid_data) ex.requests_from.insert(in->program);
     }
-    std::free(in);
+    dds_sample_free(in, &rccx_net_MotionRequest_desc,
+                    DDS_FREE_ALL);  // and any sequence Cyclone filled
     std::this_thread::sleep_for(20ms);
   }
   for (std::thread& t : threads) t.join();

@@ -12,7 +12,6 @@ namespace rccx::net {
 
 namespace {
 
-constexpr std::size_t kTerms = 8;  // Term lhs[8], rhs[8]
 constexpr std::size_t kName = 32;  // string<32>
 
 void check_name(std::string_view what, std::string_view name) {
@@ -50,6 +49,22 @@ void encode_term(const rccl::TransformPtr& t, rccx_net_Term& out) {
 }
 
 }  // namespace
+
+void RequestSample::point() noexcept {
+  msg.lhs = {kTermsPerSide, msg.lhs._length, lhs_, false};
+  msg.rhs = {kTermsPerSide, msg.rhs._length, rhs_, false};
+  msg.after = {kGates, msg.after._length, gates_, false};
+}
+
+RequestSample& RequestSample::operator=(const RequestSample& o) noexcept {
+  if (this == &o) return *this;
+  msg = o.msg;
+  std::copy(std::begin(o.lhs_), std::end(o.lhs_), lhs_);
+  std::copy(std::begin(o.rhs_), std::end(o.rhs_), rhs_);
+  std::copy(std::begin(o.gates_), std::end(o.gates_), gates_);
+  point();
+  return *this;
+}
 
 void to_pose(const math::Transform& t, rccx_net_Pose& out) noexcept {
   // Row-major r: row i is (n_i, o_i, a_i).
@@ -105,38 +120,37 @@ Reference parse_reference(const rccl::Transform& t) {
   return r;
 }
 
-void encode_position(const rccl::Position& p, rccx_net_MotionRequest& r) {
+void encode_position(const rccl::Position& p, RequestSample& r) {
   check_name("position", p.name());
-  rccx_net_MotionRequest out = r;  // bad input changes nothing: built aside, then copied
-  copy_to(out.position, p.name());
-  out.in_joints = p.in_joints();
-  out.dof = 0;
-  out.lhs_count = 0;
-  out.rhs_count = 0;
-  out.tool = 0;
+  RequestSample out = r;  // bad input changes nothing: built aside, then copied
+  rccx_net_MotionRequest& m = out.msg;
+  copy_to(m.position, p.name());
+  m.in_joints = p.in_joints();
+  m.dof = 0;
+  m.lhs._length = 0;
+  m.rhs._length = 0;
+  m.tool = 0;
   if (p.in_joints()) {
     const kin::JointVector& q = p.joint_values();
     if (q.size() > 8) throw CodecError(fmt::format("position {}: more than 8 joints", p.name()));
-    out.dof = static_cast<std::uint8_t>(q.size());
-    for (std::size_t i = 0; i < q.size(); ++i) out.joints[i] = q[i];
+    m.dof = static_cast<std::uint8_t>(q.size());
+    for (std::size_t i = 0; i < q.size(); ++i) m.joints[i] = q[i];
     r = out;
     return;
   }
   const auto& lhs = p.lhs();
   const auto& rhs = p.rhs();
-  if (lhs.size() > kTerms || rhs.size() > kTerms) {
+  if (lhs.size() > kTermsPerSide || rhs.size() > kTermsPerSide) {
     throw CodecError(
         fmt::format("position {}: {} and {} transforms a side; at most {} a side "
                     "cross processes: multiply constant ones together first",
-                    p.name(), lhs.size(), rhs.size(), kTerms));
+                    p.name(), lhs.size(), rhs.size(), kTermsPerSide));
   }
   for (std::size_t i = 0; i < lhs.size(); ++i) {
-    encode_term(lhs[i], out.lhs[i]);
-    if (lhs[i] == p.tool_transform()) out.tool = static_cast<std::uint8_t>(i);
+    encode_term(lhs[i], out.add_lhs());
+    if (lhs[i] == p.tool_transform()) m.tool = static_cast<std::uint8_t>(i);
   }
-  for (std::size_t i = 0; i < rhs.size(); ++i) encode_term(rhs[i], out.rhs[i]);
-  out.lhs_count = static_cast<std::uint8_t>(lhs.size());
-  out.rhs_count = static_cast<std::uint8_t>(rhs.size());
+  for (const auto& t : rhs) encode_term(t, out.add_rhs());
   r = out;
 }
 
@@ -150,9 +164,14 @@ rccl::PositionPtr decode_position(const rccx_net_MotionRequest& r, const Resolve
     for (std::size_t i = 0; i < r.dof; ++i) q[i] = r.joints[i];
     return rccl::Position::joints(name, q);
   }
-  if (r.lhs_count > kTerms || r.rhs_count > kTerms || r.tool >= std::max<int>(1, r.lhs_count)) {
-    throw CodecError(fmt::format("position {}: malformed ({} and {} terms, tool {})", name,
-                                 int{r.lhs_count}, int{r.rhs_count}, int{r.tool}));
+  // Cyclone checks the bounds when it receives a sample; checked again for a request made here.
+  const std::uint32_t n_lhs = r.lhs._length;
+  const std::uint32_t n_rhs = r.rhs._length;
+  if (n_lhs > kTermsPerSide || n_rhs > kTermsPerSide ||
+      r.tool >= std::max<std::uint32_t>(1, n_lhs) || (n_lhs != 0 && r.lhs._buffer == nullptr) ||
+      (n_rhs != 0 && r.rhs._buffer == nullptr)) {
+    throw CodecError(fmt::format("position {}: malformed ({} and {} terms, tool {})", name, n_lhs,
+                                 n_rhs, int{r.tool}));
   }
   const auto term = [&](const rccx_net_Term& t) -> rccl::TransformPtr {
     const std::string tname(text_of(t.name));
@@ -172,8 +191,8 @@ rccl::PositionPtr decode_position(const rccx_net_MotionRequest& r, const Resolve
         fmt::format("position {}: transform {} of unknown kind {}", name, tname, int{t.kind}));
   };
   std::vector<rccl::TransformPtr> lhs, rhs;
-  for (std::size_t i = 0; i < r.lhs_count; ++i) lhs.push_back(term(r.lhs[i]));
-  for (std::size_t i = 0; i < r.rhs_count; ++i) rhs.push_back(term(r.rhs[i]));
+  for (std::uint32_t i = 0; i < n_lhs; ++i) lhs.push_back(term(r.lhs._buffer[i]));
+  for (std::uint32_t i = 0; i < n_rhs; ++i) rhs.push_back(term(r.rhs._buffer[i]));
   const rccl::TransformPtr tool = lhs.empty() ? nullptr : lhs[r.tool];
   return rccl::Position::make(name, lhs, rhs, tool);
 }

@@ -6,9 +6,10 @@
 //   function:<name>   a function registered in the serve process (RobotServer::register_function)
 //   stream:<name>     the newest FrameSample a program writes (RemoteCell::stream(name))
 //
-//   rccx_net_MotionRequest r{};
+//   net::RequestSample r;
 //   net::encode_position(*goal, r);            // the program: throws CodecError for what cannot go
-//   rccl::PositionPtr p = net::decode_position(r, resolve);   // the serve: a new equation
+//   dds_write(writer, &r.msg);
+//   rccl::PositionPtr p = net::decode_position(taken, resolve);   // the serve: a new equation
 #pragma once
 
 #include <functional>
@@ -30,6 +31,30 @@ class CodecError : public std::invalid_argument {
   using std::invalid_argument::invalid_argument;
 };
 
+/// The bounds of MotionRequest's sequences (rccx_net.idl).
+inline constexpr std::size_t kTermsPerSide = 8;  ///< sequence<Term, 8> lhs, rhs
+inline constexpr std::size_t kGates = 4;         ///< sequence<Gate, 4> after
+
+/// A MotionRequest to write, with room for its terms and gates: `msg`'s sequences point into this
+/// object (_release false, so nothing frees them through it), so building and writing one
+/// allocates nothing. Copying re-points the copy's sequences at its own storage.
+struct RequestSample {
+  rccx_net_MotionRequest msg{};
+  RequestSample() noexcept { point(); }
+  RequestSample(const RequestSample& o) noexcept { *this = o; }
+  RequestSample& operator=(const RequestSample& o) noexcept;
+  /// Appends a zeroed term to lhs or rhs / a gate (the caller checked the bound).
+  rccx_net_Term& add_lhs() noexcept { return lhs_[msg.lhs._length++] = rccx_net_Term{}; }
+  rccx_net_Term& add_rhs() noexcept { return rhs_[msg.rhs._length++] = rccx_net_Term{}; }
+  rccx_net_Gate& add_gate() noexcept { return gates_[msg.after._length++] = rccx_net_Gate{}; }
+
+ private:
+  void point() noexcept;
+  rccx_net_Term lhs_[kTermsPerSide]{};
+  rccx_net_Term rhs_[kTermsPerSide]{};
+  rccx_net_Gate gates_[kGates]{};
+};
+
 void to_pose(const math::Transform& t, rccx_net_Pose& out) noexcept;
 [[nodiscard]] math::Transform from_pose(const rccx_net_Pose& p) noexcept;
 
@@ -43,15 +68,16 @@ struct Reference {
 
 /// Writes `p` into the request's position fields (position, in_joints, dof, joints, lhs, rhs,
 /// tool). Throws CodecError (the request untouched) for a functional transform without a
-/// reference, more than 8 terms a side, or a name longer than 31 characters.
-void encode_position(const rccl::Position& p, rccx_net_MotionRequest& r);
+/// reference, more than kTermsPerSide terms a side, or a name longer than 31 characters.
+void encode_position(const rccl::Position& p, RequestSample& r);
 
 /// Makes the transform a received functional term stands for: `kind` frame, function or stream
 /// with its name. Throws (CodecError or std::invalid_argument) to refuse it, saying why.
 using Resolver = std::function<rccl::TransformPtr(TermKind kind, std::string_view name)>;
 
 /// The position of a request: a new equation whose constant and hold terms carry the values
-/// sent, T6, and functional terms from `resolve`. Throws CodecError for a malformed request,
+/// sent, T6, and functional terms from `resolve`. Throws CodecError for a malformed request (a
+/// side longer than its bound, a tool index outside lhs),
 /// rccl::EquationError for a bad equation, what `resolve` throws.
 [[nodiscard]] rccl::PositionPtr decode_position(const rccx_net_MotionRequest& r,
                                                 const Resolver& resolve);

@@ -22,14 +22,22 @@ void raise_priority() noexcept;
   return static_cast<double>(ns) * 1e-6;
 }
 
-/// Room for up to `capacity` samples of T taken off a reader, made once: a take into it
-/// allocates nothing (every rccx type is bounded, so Cyclone deserializes in place).
+/// Room for up to `capacity` samples of T (its Cyclone type `type`) taken off a reader, made
+/// once: Cyclone deserializes in place, and a sequence's buffer it allocates for the first
+/// sample that fills it is reused by later takes (freed with the inbox), so takes allocate
+/// nothing once each slot has seen its longest sample.
 template <class T>
 class Inbox {
  public:
-  explicit Inbox(std::size_t capacity) : buf_(capacity), ptrs_(capacity), info_(capacity) {
+  Inbox(const dds_topic_descriptor_t& type, std::size_t capacity)
+      : type_(&type), buf_(capacity), ptrs_(capacity), info_(capacity) {
     for (std::size_t i = 0; i < capacity; ++i) ptrs_[i] = &buf_[i];
   }
+  ~Inbox() {
+    for (T& s : buf_) dds_sample_free(&s, type_, DDS_FREE_CONTENTS);
+  }
+  Inbox(const Inbox&) = delete;
+  Inbox& operator=(const Inbox&) = delete;
   /// Takes up to capacity() samples of `reader`: how many (0 on an error), in info() order
   /// (invalid ones: instance state changes). Fewer than capacity(): the reader is empty.
   int take(dds_entity_t reader) {
@@ -42,6 +50,7 @@ class Inbox {
   [[nodiscard]] bool valid(int i) const { return info_[static_cast<std::size_t>(i)].valid_data; }
 
  private:
+  const dds_topic_descriptor_t* type_;
   std::vector<T> buf_;
   std::vector<void*> ptrs_;
   std::vector<dds_sample_info_t> info_;

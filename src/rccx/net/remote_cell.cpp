@@ -37,6 +37,24 @@ rccl::MotionEvent to_event(const rccx_net_MotionEvent& e) {
   return m;
 }
 
+/// A motion's gates into its request; MotionError (nothing written) for more than the wire's
+/// bound or a gate without a ledger.
+void encode_gates(const rccl::StartWhen& when, RequestSample& r) {
+  if (when.after.size() > kGates) {
+    throw rccl::MotionError(fmt::format("at most {} gates a motion cross processes, not {}", kGates,
+                                        when.after.size()));
+  }
+  for (const rccl::EventGate& g : when.after) {
+    if (g.ledger == nullptr) throw rccl::MotionError("a gate without a ledger");
+  }
+  for (const rccl::EventGate& g : when.after) {
+    rccx_net_Gate& out = r.add_gate();
+    copy_to(out.robot, g.ledger->robot());
+    out.kind = g.kind == rccl::EventGate::Kind::started ? 0 : 1;
+    out.motion = g.id;
+  }
+}
+
 rccl::MotionEvent lost_event(std::uint64_t id, std::string_view why) {
   rccl::MotionEvent m;
   m.kind = rccl::EventKind::failed;
@@ -118,8 +136,9 @@ void RemoteArm::set_compliance(const rccl::Compliance& compliance) {
   settings_.compliance = compliance;
 }
 
-rccx_net_MotionAck RemoteArm::request(rccx_net_MotionRequest& r) {
+rccx_net_MotionAck RemoteArm::request(RequestSample& sample) {
   RemoteCell& c = cell_;
+  rccx_net_MotionRequest& r = sample.msg;
   copy_to(r.robot, name_);
   copy_to(r.program, c.participant_name_);
   r.program_instance = c.instance_;
@@ -168,28 +187,18 @@ rccl::Motion RemoteArm::move(const rccl::PositionPtr& position, const rccl::Star
         "a joint start (Cell::together) across processes is not supported yet: use gates "
         "(cell.after(robot, event))");
   }
-  if (when.after.size() > 4) {
-    throw rccl::MotionError("at most 4 gates a motion cross processes");
-  }
-  rccx_net_MotionRequest r{};
-  r.kind = static_cast<std::uint8_t>(RequestKind::move);
+  RequestSample r;
+  r.msg.kind = static_cast<std::uint8_t>(RequestKind::move);
   rccl::MotionSettings s = settings_;
   s.may_touch = when.touch;
-  encode_settings(s, r);
+  encode_settings(s, r.msg);
   try {
     encode_position(*position, r);
   } catch (const CodecError& e) {
     throw rccl::MotionError(
         fmt::format("robot {}: move({}): {}", name_, position->name(), e.what()));
   }
-  for (std::size_t i = 0; i < when.after.size(); ++i) {
-    const rccl::EventGate& g = when.after[i];
-    if (g.ledger == nullptr) throw rccl::MotionError("a gate without a ledger");
-    copy_to(r.after[i].robot, g.ledger->robot());
-    r.after[i].kind = g.kind == rccl::EventGate::Kind::started ? 0 : 1;
-    r.after[i].motion = g.id;
-  }
-  r.gates = static_cast<std::uint8_t>(when.after.size());
+  encode_gates(when, r);
   const rccx_net_MotionAck ack = request(r);
   last_queued_ = std::max(last_queued_, ack.motion);
   position_last_[position.get()] = ack.motion;
@@ -198,49 +207,44 @@ rccl::Motion RemoteArm::move(const rccl::PositionPtr& position, const rccl::Star
 
 rccl::Motion RemoteArm::dwell(double seconds, const rccl::StartWhen& when) {
   if (when.together) throw rccl::MotionError("a joint start across processes: not supported yet");
-  rccx_net_MotionRequest r{};
-  r.kind = static_cast<std::uint8_t>(RequestKind::dwell);
+  RequestSample r;
+  r.msg.kind = static_cast<std::uint8_t>(RequestKind::dwell);
   rccl::MotionSettings s = settings_;
   s.may_touch = when.touch;
-  encode_settings(s, r);
-  r.value = seconds;
-  for (std::size_t i = 0; i < when.after.size() && i < 4; ++i) {
-    copy_to(r.after[i].robot, when.after[i].ledger->robot());
-    r.after[i].kind = when.after[i].kind == rccl::EventGate::Kind::started ? 0 : 1;
-    r.after[i].motion = when.after[i].id;
-  }
-  r.gates = static_cast<std::uint8_t>(std::min<std::size_t>(when.after.size(), 4));
+  encode_settings(s, r.msg);
+  r.msg.value = seconds;
+  encode_gates(when, r);
   const rccx_net_MotionAck ack = request(r);
   last_queued_ = std::max(last_queued_, ack.motion);
   return rccl::Motion{ack.motion};
 }
 
 void RemoteArm::halt() {
-  rccx_net_MotionRequest r{};
-  r.kind = static_cast<std::uint8_t>(RequestKind::halt);
-  encode_settings(settings_, r);
+  RequestSample r;
+  r.msg.kind = static_cast<std::uint8_t>(RequestKind::halt);
+  encode_settings(settings_, r.msg);
   (void)request(r);
 }
 
 void RemoteArm::nextmove() {
-  rccx_net_MotionRequest r{};
-  r.kind = static_cast<std::uint8_t>(RequestKind::nextmove);
-  encode_settings(settings_, r);
+  RequestSample r;
+  r.msg.kind = static_cast<std::uint8_t>(RequestKind::nextmove);
+  encode_settings(settings_, r.msg);
   (void)request(r);
 }
 
 void RemoteArm::set_hand(bool closed) {
-  rccx_net_MotionRequest r{};
-  r.kind = static_cast<std::uint8_t>(RequestKind::hand);
-  encode_settings(settings_, r);
-  r.value = closed ? 1.0 : 0.0;
+  RequestSample r;
+  r.msg.kind = static_cast<std::uint8_t>(RequestKind::hand);
+  encode_settings(settings_, r.msg);
+  r.msg.value = closed ? 1.0 : 0.0;
   (void)request(r);
 }
 
 void RemoteArm::attach() {
-  rccx_net_MotionRequest r{};
-  r.kind = static_cast<std::uint8_t>(RequestKind::attach);
-  encode_settings(settings_, r);
+  RequestSample r;
+  r.msg.kind = static_cast<std::uint8_t>(RequestKind::attach);
+  encode_settings(settings_, r.msg);
   const rccx_net_MotionAck ack = request(r);
   last_queued_ = std::max(last_queued_, ack.motion);
 }
@@ -413,7 +417,7 @@ RemoteCell::RemoteCell(cell::CellModel model, NetOptions net, RemoteOptions opti
   frame_writer_ = participant_->writer(Topic::frame);
   state_reader_ = participant_->reader(Topic::state, net_.detection * 10);
   states_in_ = std::make_unique<StateInbox>();
-  events_in_ = std::make_unique<Inbox<rccx_net_MotionEvent>>(16);
+  events_in_ = std::make_unique<Inbox<rccx_net_MotionEvent>>(rccx_net_MotionEvent_desc, 16);
   ack_reader_ = participant_->reader(Topic::ack);
   event_reader_ = participant_->reader(Topic::event);
   waitset_ = Entity(check(dds_create_waitset(participant_->get()), "a waitset"));

@@ -49,6 +49,7 @@ class Inbox;
 }  // namespace detail
 
 class RemoteCell;
+struct RequestSample;
 
 /// A robot's newest state as its serve process sent it.
 struct RemoteState {
@@ -149,7 +150,7 @@ class RemoteArm : public rccl::Arm {
   friend class RemoteCell;
   /// Sends `r` (its robot, program and id filled here) and waits for the answer; throws
   /// MotionError for a refusal or no answer.
-  rccx_net_MotionAck request(rccx_net_MotionRequest& r);
+  rccx_net_MotionAck request(RequestSample& r);
   [[nodiscard]] rccl::GateAnswer answer(const rccl::Event& e) const;
 
   RemoteCell& cell_;

@@ -100,10 +100,10 @@ struct RobotServer::Local {
 /// Room for what a pass takes off the readers, made once (a request's answer in the receive
 /// thread allocates no take buffers).
 struct RobotServer::Inboxes {
-  Inbox<rccx_net_Heartbeat> heartbeats{16};
+  Inbox<rccx_net_Heartbeat> heartbeats{rccx_net_Heartbeat_desc, 16};
   StateInbox states{4};
-  Inbox<rccx_net_FrameSample> frames{8};
-  Inbox<rccx_net_MotionRequest> requests{4};
+  Inbox<rccx_net_FrameSample> frames{rccx_net_FrameSample_desc, 8};
+  Inbox<rccx_net_MotionRequest> requests{rccx_net_MotionRequest_desc, 4};
 };
 
 struct RobotServer::Dedup {
@@ -744,8 +744,10 @@ void RobotServer::execute(Local& l, const rccx_net_MotionRequest& r, rccx_net_Mo
   // The gates: this process's robots from the cell, others' from their states.
   rccl::StartWhen when;
   when.touch = s.may_touch;
-  for (std::size_t i = 0; i < std::min<std::size_t>(r.gates, 4); ++i) {
-    const rccx_net_Gate& g = r.after[i];
+  const std::uint32_t gates = r.after._buffer == nullptr ? 0 : r.after._length;
+  if (gates > kGates) throw CodecError(fmt::format("{} gates; at most {}", gates, kGates));
+  for (std::uint32_t i = 0; i < gates; ++i) {
+    const rccx_net_Gate& g = r.after._buffer[i];
     const std::string robot(text_of(g.robot));
     const auto gk = g.kind == 0 ? rccl::EventGate::Kind::started : rccl::EventGate::Kind::ended;
     if (local(robot) != nullptr) {
