@@ -71,6 +71,7 @@ class StateRecorder {
     kin::JointVector q;
     math::Transform tool;
     std::uint64_t running = 0;
+    net::RobotStatus status = net::RobotStatus::not_started;
     std::int64_t received_ns = 0;
   };
   explicit StateRecorder(std::uint32_t d) : recorder_(d, std::chrono::milliseconds(kDetectionMs)) {}
@@ -85,6 +86,7 @@ class StateRecorder {
       d.q = kin::JointVector(std::span<const double>(s.q_commanded, s.dof));
       d.tool = net::from_pose(s.tool);
       d.running = s.running;
+      d.status = static_cast<net::RobotStatus>(s.status);
       d.received_ns = r.received_ns;
       out.push_back(d);
     }
@@ -522,6 +524,18 @@ TEST(NetServe, AKilledProgramsRobotStopsSmoothlyAndTheServeSaysWhy) {
     return i == 0 ? 0.0 : std::abs(v[i].q[0] - v[i - 1].q[0]) / P;
   };
   EXPECT_LT(speed(k), speed(kill_index) + 1e-9) << "not slowing down yet";
+  // What the states said meanwhile: moving at the kill, stopping while it slowed (never moving
+  // again once stopping), at rest at the end.
+  EXPECT_EQ(v[kill_index > 0 ? kill_index - 1 : 0].status, net::RobotStatus::moving);
+  std::size_t first_stopping = v.size();
+  for (std::size_t i = kill_index; i < v.size(); ++i) {
+    if (v[i].status == net::RobotStatus::stopping && first_stopping == v.size()) first_stopping = i;
+    if (first_stopping < i) {
+      EXPECT_NE(v[i].status, net::RobotStatus::moving) << "moving again at sample " << v[i].sample;
+    }
+  }
+  ASSERT_LT(first_stopping, rest) << "no state said stopping before the robot came to rest";
+  EXPECT_EQ(v.back().status, net::RobotStatus::at_rest);
 }
 
 /// One attempt of the test below (net_attempts.hpp: a serve's overrun runs it again); attempt k

@@ -39,6 +39,7 @@ struct Slot {
   double qd[8]{};  ///< rad/s / m/s: the setpoints' last difference over the period
   cell::ToolSample tool;
   std::uint64_t running = 0;
+  bool halting = false;  ///< the setpoint is a halt's (RobotStatus::stopping)
   std::int64_t stamp_ns = 0;
 };
 
@@ -381,6 +382,7 @@ void RobotServer::on_cycle(const cell::Cell& cell) noexcept {
       }
       s.tool = cell.tool_sample(l.name);  // the seqlock: no lock, no allocation
       s.running = l.gen->last_motion();
+      s.halting = l.gen->halting();
       // The setpoint is for two periods after this sample (Manipulator's pipeline).
       s.stamp_ns = wall_ns() + static_cast<std::int64_t>((t - s.tool.t_s) * 1e9) +
                    static_cast<std::int64_t>(2.0 * l.period_s * 1e9);
@@ -925,6 +927,8 @@ void RobotServer::publish_states(std::int64_t now, bool last) {
     } else if (last) {
       s.status = static_cast<std::uint8_t>(RobotStatus::ended);
       copy_to(s.termination, "the serve process stopped");
+    } else if (l.slot.halting) {
+      s.status = static_cast<std::uint8_t>(RobotStatus::stopping);
     } else {
       s.status = static_cast<std::uint8_t>(l.slot.running != 0 ? RobotStatus::moving
                                                                : RobotStatus::at_rest);

@@ -86,6 +86,9 @@ class TrajectoryGenerator {
   [[nodiscard]] const kin::JointVector& last_setpoint() const noexcept { return loop_.last_q; }
   [[nodiscard]] const kin::JointVector& previous_setpoint() const noexcept { return loop_.prev_q; }
   [[nodiscard]] double last_setpoint_time_s() const noexcept { return loop_.last_t; }
+  /// The last setpoint belongs to a halt: the arm is stopping smoothly (a halt(), a failure, a
+  /// nextmove, a stop request such as a cell's collision stop or a lost link).
+  [[nodiscard]] bool halting() const noexcept { return loop_.phase == Phase::halting; }
   /// Asks the next step() to stop smoothly (each joint within its acceleration bound) when the
   /// arm moves - a motion, a transition, or a Cartesian rest tracking a moving goal - failing
   /// the motion with `why` (truncated to kEventText - 1 characters) and cancelling the queue.
