@@ -62,11 +62,13 @@ fuzz: deps
 	$(CMAKE) --build $(FUZZ_DIR) -j$(JOBS) --target fuzz_targets
 	scripts/fuzz --build $(FUZZ_DIR) --seconds $(FUZZ_SECONDS)
 
-# The threaded parts (RTC sessions) under ThreadSanitizer.
+# The threaded parts (RTC sessions, a cell's tasks, a serve's and a program's threads) under
+# ThreadSanitizer.
 tsan: deps
 	$(CMAKE) -S . -B $(TSAN_DIR) -DCMAKE_BUILD_TYPE=Debug -DRCCX_TSAN=ON -DRCCX_BUILD_BENCHMARKS=OFF
-	$(CMAKE) --build $(TSAN_DIR) -j$(JOBS) --target rccx_rtc_tests rccx_cell_runtime_tests rccx_compat_rtc_tests
-	cd $(TSAN_DIR) && TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1" \
+	$(CMAKE) --build $(TSAN_DIR) -j$(JOBS) --target rccx_rtc_tests rccx_cell_runtime_tests rccx_compat_rtc_tests \
+	  rccx_net_threads_tests
+	cd $(TSAN_DIR) && TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1 suppressions=$(CURDIR)/tests/tsan-suppressions.txt" \
 	  ctest -L rtc --output-on-failure -j$(JOBS)
 
 # Release benchmarks against Orocos KDL; JSON under bench-results/. The cell's cycle runs

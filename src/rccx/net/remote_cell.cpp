@@ -456,8 +456,14 @@ RemoteCell::RemoteCell(cell::CellModel model, NetOptions net, RemoteOptions opti
       }
       serves.insert(std::string(text_of(a->state_->participant)));
     }
+    // Outside mutex_: a request written in this process to a serve in this process delivers
+    // its ack to take_acks() (which takes mutex_) while the writer's lock is held, so holding
+    // mutex_ here while taking the writer's lock is the other order (ThreadSanitizer, tests/
+    // net_threads_test.cpp).
+    lock.unlock();
     dds_publication_matched_status_t st{};
     (void)dds_get_publication_matched_status(request_writer_.get(), &st);
+    lock.lock();
     if (missing == nullptr && st.current_count >= serves.size()) break;
     if (steady_ns() >= until) {
       lock.unlock();
