@@ -514,6 +514,26 @@ std::unique_ptr<Child> start_serve(std::uint32_t domain, const char* robots,
   return std::make_unique<Child>(Child::Program{}, argv);
 }
 
+/// The serve's own count of how it answered (`rccx serve: N requests: A answered at once in the
+/// listener, B by the middleware thread ...`, printed when it stops) as counters: the share of
+/// requests that found the middleware thread in a pass and waited for its next one.
+void serve_request_counters(benchmark::State& state, const std::string& serve_output) {
+  const std::string key = "rccx serve: ";
+  for (std::size_t at = serve_output.find(key); at != std::string::npos;
+       at = serve_output.find(key, at + 1)) {
+    unsigned long long total = 0, listener = 0, pass = 0;
+    if (std::sscanf(serve_output.c_str() + at + key.size(),
+                    "%llu requests: %llu answered at once in the listener, %llu by the middleware",
+                    &total, &listener, &pass) == 3 &&
+        total > 0) {
+      state.counters["serve_answered_in_pass"] = static_cast<double>(pass);
+      state.counters["serve_answered_in_pass_pct"] =
+          100.0 * static_cast<double>(pass) / static_cast<double>(total);
+      return;
+    }
+  }
+}
+
 constexpr const char* kNoServe =
     "set RCCX_BENCH_RCCX (the rccx executable) and RCCX_BENCH_CELL (a cell file) to run "
     "against rccx serve (scripts/bench-net does)";
@@ -618,7 +638,7 @@ void BM_ServeRequestAckWire(benchmark::State& state) {
       if (i > warmup) ns.push_back((t1 - t0).count());
     }
     set_latency_counters(state, ns);
-    (void)w.serve->terminate(5s);
+    serve_request_counters(state, w.serve->terminate(5s));
   }
 }
 BENCHMARK(BM_ServeRequestAckWire)->Iterations(1)->Unit(benchmark::kMillisecond)->UseRealTime();
@@ -717,7 +737,7 @@ void BM_ServeRequestAckWireListener(benchmark::State& state) {
       }
     }
     set_latency_counters(state, ping.ns);
-    (void)w.serve->terminate(5s);
+    serve_request_counters(state, w.serve->terminate(5s));
   }
 }
 BENCHMARK(BM_ServeRequestAckWireListener)
@@ -758,7 +778,7 @@ void BM_ServeRequestAckApi(benchmark::State& state) {
       state.SkipWithError(e.what());
       return;
     }
-    (void)serve->terminate(5s);
+    serve_request_counters(state, serve->terminate(5s));
   }
 }
 BENCHMARK(BM_ServeRequestAckApi)->Iterations(1)->Unit(benchmark::kMillisecond)->UseRealTime();

@@ -13,6 +13,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <map>
 #include <mutex>
@@ -344,6 +345,22 @@ TEST(NetServe, ABurstOfRequestsIsAnsweredOnceEachInTheOrderWritten) {
                                        kRepeated, kDwellEvery, before);
   std::this_thread::sleep_for(200ms);
   EXPECT_EQ(puma.queued(), before + kRequests / kDwellEvery) << "a dwell was queued twice";
+  // When it stops, the serve says how it answered them: at once in the listener, or in its
+  // middleware thread's next pass (scripts/bench-net reads this line).
+  kill(puma.process->pid(), SIGTERM);
+  ASSERT_NE(puma.process->wait_exit(15s), -1) << "the serve did not stop on SIGTERM";
+  const std::string out = puma.process->out();
+  const std::size_t at = out.find(" requests: ");
+  ASSERT_NE(at, std::string::npos) << out;
+  unsigned long long total = 0, listener = 0, pass = 0;
+  ASSERT_EQ(
+      std::sscanf(out.c_str() + out.rfind("rccx serve: ", at) + 12,
+                  "%llu requests: %llu answered at once in the listener, %llu by the middleware",
+                  &total, &listener, &pass),
+      3)
+      << out;
+  EXPECT_EQ(listener + pass, total);
+  EXPECT_GE(total, kRequests + kRepeated);
 }
 
 // A program stopped in a debugger (here SIGSTOP) keeps its ack and event readers matched while

@@ -66,7 +66,23 @@ TEST(NetThreads, RequestsWhileTheRobotMovesAndAHaltSaidInTheStateAcrossTheServes
   q[0] += 0.6;  // about 2 s at 0.3 rad/s: still moving after the requests and at the halt
   q[2] -= 0.1;
   const rccl::Motion m = puma.move(rccl::Position::joints("AWAY", q));
-  ASSERT_EQ(puma.waitfor(m.start(), 10s), rccl::WaitResult::reached) << serve.failure();
+  // A TSan build on a loaded machine may miss a 10 ms deadline: the serve ends that control
+  // (RTC's rule), starts it again at rest and fails the motion with the reason. Not what this
+  // test checks: it skips then, saying why (net_attempts.hpp's two texts of an overrun).
+  const auto overrun = [&]() -> std::string {
+    for (const auto& e : puma.failures()) {
+      const std::string why(e.message());
+      if (why.find("was still running at the next tick") != std::string::npos ||
+          why.find("did not hand Chg over within its period") != std::string::npos) {
+        return why;
+      }
+    }
+    return {};
+  };
+  if (puma.waitfor(m.start(), 10s) != rccl::WaitResult::reached) {
+    if (const std::string why = overrun(); !why.empty()) GTEST_SKIP() << "an overrun: " << why;
+    FAIL() << "the motion did not start: " << serve.failure();
+  }
   // Requests for 0.5 s of the motion, each answered (an attach's answer carries the serve's
   // last motion queued: still the move's).
   int requests = 0;
@@ -75,12 +91,8 @@ TEST(NetThreads, RequestsWhileTheRobotMovesAndAHaltSaidInTheStateAcrossTheServes
     puma.attach();
     ASSERT_EQ(puma.last_queued(), m.id) << "after " << requests << " requests";
   }
-  const net::RemoteState during = puma.state();
-  if (during.status == net::RobotStatus::ended || during.control_ended) {
-    GTEST_SKIP() << "the serve's control ended (" << during.termination
-                 << "): a TSan build missed its 10 ms deadline on this machine";
-  }
-  EXPECT_EQ(during.status, net::RobotStatus::moving);
+  if (const std::string why = overrun(); !why.empty()) GTEST_SKIP() << "an overrun: " << why;
+  EXPECT_EQ(puma.state().status, net::RobotStatus::moving);
 
   // A halt while it moves: the states say stopping, then at rest.
   puma.halt();
@@ -90,16 +102,16 @@ TEST(NetThreads, RequestsWhileTheRobotMovesAndAHaltSaidInTheStateAcrossTheServes
     const net::RemoteState s = puma.state();
     stopping = stopping || s.status == net::RobotStatus::stopping;
     at_rest = stopping && s.status == net::RobotStatus::at_rest;
-    if (s.status == net::RobotStatus::ended) {
-      GTEST_SKIP() << "the serve's control ended (" << s.termination
-                   << "): a TSan build missed its 10 ms deadline on this machine";
-    }
     std::this_thread::sleep_for(1ms);
   }
+  if (const std::string why = overrun(); !why.empty()) GTEST_SKIP() << "an overrun: " << why;
   EXPECT_TRUE(stopping) << "no state said stopping during the halt";
   EXPECT_TRUE(at_rest) << "not at rest 10 s after the halt";
   EXPECT_EQ(serve.failure(), "");
-  std::printf("%d requests answered while moving; the halt said stopping, then at rest\n",
-              requests);
+  // Every request was answered one way or the other (a re-sent one counts twice).
+  const net::RobotServer::RequestCounts counts = serve.request_counts();
+  EXPECT_GE(counts.in_listener + counts.in_pass, static_cast<std::uint64_t>(requests) + 2);
+  std::printf("%d requests answered while moving; the halt said stopping, then at rest; %s\n",
+              requests, serve.request_report().c_str());
   serve.stop();
 }

@@ -84,6 +84,7 @@ int run_serve(const ServeArgs& args) {
   }
   server->stop();
   fmt::print("rccx serve: the control clock, {}\n", server->clock_report());
+  fmt::print("rccx serve: {}\n", server->request_report());
   if (const std::string why = server->failure(); !why.empty()) {
     io::eprint("rccx serve: stopped on an error: {}\n", why);
     return kFailure;

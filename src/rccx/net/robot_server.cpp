@@ -355,6 +355,23 @@ void RobotServer::stop() {
   cell_.reset();  // ends control
 }
 
+RobotServer::RequestCounts RobotServer::request_counts() const {
+  const std::lock_guard pass(serve_mutex_);
+  return {answered_in_listener_, answered_in_pass_,
+          listener_handed_over_.load(std::memory_order_relaxed)};
+}
+
+std::string RobotServer::request_report() const {
+  const RequestCounts c = request_counts();
+  const std::uint64_t total = c.in_listener + c.in_pass;
+  return fmt::format(
+      "{} requests: {} answered at once in the listener, {} by the middleware thread ({:.2f} %; "
+      "the listener found a pass under way {} times)",
+      total, c.in_listener, c.in_pass,
+      total == 0 ? 0.0 : 100.0 * static_cast<double>(c.in_pass) / static_cast<double>(total),
+      c.handed_over);
+}
+
 std::string RobotServer::clock_report() const {
   if (!cell_ || locals_.empty()) return clock_report_;
   return clock_figures(*locals_.front()->session, cell_->group().period());
@@ -448,7 +465,7 @@ void RobotServer::poll() {
   read_heartbeats(now);
   read_states(now);
   read_frames(now);
-  read_requests(now);
+  answered_in_pass_ += read_requests(now);
   publish_events();
   publish_states(now);
   restart_after_overruns();
@@ -505,6 +522,7 @@ void RobotServer::answer_in_receive_thread() noexcept {
   std::unique_lock pass(serve_mutex_, std::try_to_lock);
   if (!pass.owns_lock() || stop_.load() || !answering_.load()) {
     // The middleware thread is in a pass (or stopping): it takes the request on its next one.
+    if (!pass.owns_lock()) listener_handed_over_.fetch_add(1, std::memory_order_relaxed);
     rtc::detail::ring(wake_);
     return;
   }
@@ -514,7 +532,7 @@ void RobotServer::answer_in_receive_thread() noexcept {
     read_heartbeats(now);
     read_states(now);
     read_frames(now);
-    read_requests(now);
+    answered_in_listener_ += read_requests(now);
   } catch (const std::exception& e) {  // an answer not written: the serve stops, saying why
     {
       const std::lock_guard lock(failure_mutex_);
@@ -591,14 +609,17 @@ void RobotServer::read_frames(std::int64_t now) {
   }
 }
 
-void RobotServer::read_requests(std::int64_t now) {
+std::uint64_t RobotServer::read_requests(std::int64_t now) {
   auto& in = inboxes_->requests;
+  std::uint64_t count = 0;
   for (;;) {
     const int n = in.take(request_reader_.get());
     for (int i = 0; i < n; ++i) {
-      if (in.valid(i)) handle(in[i], now);
+      if (!in.valid(i)) continue;
+      handle(in[i], now);
+      ++count;
     }
-    if (n < in.capacity()) break;
+    if (n < in.capacity()) return count;
   }
 }
 

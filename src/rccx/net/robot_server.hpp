@@ -97,6 +97,16 @@ class RobotServer {
   /// The control clock's figures so far (after stop(): until then): ticks, the cycle's
   /// computing time and the wake-up latency (us), deadlines missed.
   [[nodiscard]] std::string clock_report() const;
+  /// How the requests were answered so far: in the listener at once, or by the middleware
+  /// thread's next pass because the listener found a pass under way (the slower way).
+  struct RequestCounts {
+    std::uint64_t in_listener = 0;
+    std::uint64_t in_pass = 0;
+    std::uint64_t handed_over = 0;  ///< times the listener found a pass under way
+  };
+  [[nodiscard]] RequestCounts request_counts() const;
+  /// request_counts() in a line for people.
+  [[nodiscard]] std::string request_report() const;
 
  private:
   struct Local;
@@ -119,7 +129,8 @@ class RobotServer {
   void read_heartbeats(std::int64_t now);
   void read_states(std::int64_t now);
   void read_frames(std::int64_t now);
-  void read_requests(std::int64_t now);
+  /// Takes and answers the requests there are: how many.
+  std::uint64_t read_requests(std::int64_t now);
   void handle(const rccx_net_MotionRequest& r, std::int64_t now);
   /// Writes an ack (its writer never waits: one it cannot take yet waits in acks_backlog_).
   void answer(const rccx_net_MotionAck& ack);
@@ -164,10 +175,14 @@ class RobotServer {
   /// Held by the middleware thread for each pass, tried by the request listener
   /// (answer_in_receive_thread): what they share has one user at a time. Before the entities:
   /// deleting a reader waits for its listener, which may hold it.
-  std::mutex serve_mutex_;
+  mutable std::mutex serve_mutex_;
   std::unique_ptr<Inboxes> inboxes_;  ///< serve_mutex_
   /// The request listener answers only from the end of start() to stop().
   std::atomic<bool> answering_{false};
+  std::uint64_t answered_in_listener_ = 0;  ///< serve_mutex_
+  std::uint64_t answered_in_pass_ = 0;      ///< serve_mutex_
+  /// Times the listener found the middleware thread in a pass and handed the request over.
+  std::atomic<std::uint64_t> listener_handed_over_{0};
   std::unique_ptr<Participant> participant_;
   Entity hb_writer_, hb_reader_, claim_writer_, claim_reader_, state_writer_, state_reader_,
       request_reader_, ack_writer_, event_writer_, frame_reader_;
