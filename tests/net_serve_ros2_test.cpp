@@ -29,8 +29,9 @@ const std::string kCell = std::string(RCCX_CELLS_DIR) + "/cvarl.json";
 constexpr std::chrono::milliseconds kDetection{50};
 
 /// A domain of this test process's own, 10 .. 39 (apart from the other net tests' ranges).
-std::uint32_t domain() {
-  return 10 + static_cast<std::uint32_t>(getpid() % 30);
+/// Domains 10 .. 41: attempt k (net_attempts.hpp) on a domain of its own, as the other tests.
+std::uint32_t domain(int attempt) {
+  return 10 + static_cast<std::uint32_t>(getpid() % 30) + static_cast<std::uint32_t>(attempt - 1);
 }
 
 /// One JointState as read, copied out of Cyclone's loan.
@@ -111,7 +112,7 @@ class Ros2Subscriber {
 
 /// One attempt (net_attempts.hpp): a serve's overrun makes it again on fresh serves.
 static void ros2_once(int attempt, bool& again) {
-  const std::uint32_t d = domain();
+  const std::uint32_t d = domain(attempt);
   auto serve = test::spawn_serve(kCell, d, "puma", "ros2_serve_puma", kDetection);
   auto quiet =
       test::spawn_serve(kCell, d, "microbo", "ros2_serve_microbo", kDetection, {"--no-ros2"});

@@ -55,6 +55,14 @@ void encode_gates(const rccl::StartWhen& when, RequestSample& r) {
   }
 }
 
+/// A request of `kind` with the settings it is queued with (every request carries them).
+RequestSample request_of(RequestKind kind, const rccl::MotionSettings& settings) {
+  RequestSample r;
+  r.msg.kind = static_cast<std::uint8_t>(kind);
+  encode_settings(settings, r.msg);
+  return r;
+}
+
 rccl::MotionEvent lost_event(std::uint64_t id, std::string_view why) {
   rccl::MotionEvent m;
   m.kind = rccl::EventKind::failed;
@@ -187,11 +195,9 @@ rccl::Motion RemoteArm::move(const rccl::PositionPtr& position, const rccl::Star
         "a joint start (Cell::together) across processes is not supported yet: use gates "
         "(cell.after(robot, event))");
   }
-  RequestSample r;
-  r.msg.kind = static_cast<std::uint8_t>(RequestKind::move);
   rccl::MotionSettings s = settings_;
   s.may_touch = when.touch;
-  encode_settings(s, r.msg);
+  RequestSample r = request_of(RequestKind::move, s);
   try {
     encode_position(*position, r);
   } catch (const CodecError& e) {
@@ -207,11 +213,9 @@ rccl::Motion RemoteArm::move(const rccl::PositionPtr& position, const rccl::Star
 
 rccl::Motion RemoteArm::dwell(double seconds, const rccl::StartWhen& when) {
   if (when.together) throw rccl::MotionError("a joint start across processes: not supported yet");
-  RequestSample r;
-  r.msg.kind = static_cast<std::uint8_t>(RequestKind::dwell);
   rccl::MotionSettings s = settings_;
   s.may_touch = when.touch;
-  encode_settings(s, r.msg);
+  RequestSample r = request_of(RequestKind::dwell, s);
   r.msg.value = seconds;
   encode_gates(when, r);
   const rccx_net_MotionAck ack = request(r);
@@ -220,31 +224,23 @@ rccl::Motion RemoteArm::dwell(double seconds, const rccl::StartWhen& when) {
 }
 
 void RemoteArm::halt() {
-  RequestSample r;
-  r.msg.kind = static_cast<std::uint8_t>(RequestKind::halt);
-  encode_settings(settings_, r.msg);
+  RequestSample r = request_of(RequestKind::halt, settings_);
   (void)request(r);
 }
 
 void RemoteArm::nextmove() {
-  RequestSample r;
-  r.msg.kind = static_cast<std::uint8_t>(RequestKind::nextmove);
-  encode_settings(settings_, r.msg);
+  RequestSample r = request_of(RequestKind::nextmove, settings_);
   (void)request(r);
 }
 
 void RemoteArm::set_hand(bool closed) {
-  RequestSample r;
-  r.msg.kind = static_cast<std::uint8_t>(RequestKind::hand);
-  encode_settings(settings_, r.msg);
+  RequestSample r = request_of(RequestKind::hand, settings_);
   r.msg.value = closed ? 1.0 : 0.0;
   (void)request(r);
 }
 
 void RemoteArm::attach() {
-  RequestSample r;
-  r.msg.kind = static_cast<std::uint8_t>(RequestKind::attach);
-  encode_settings(settings_, r.msg);
+  RequestSample r = request_of(RequestKind::attach, settings_);
   const rccx_net_MotionAck ack = request(r);
   last_queued_ = std::max(last_queued_, ack.motion);
 }
