@@ -42,7 +42,9 @@
 // thread), RCCX_BENCH_KEEP_LAST=1 (request and ack reliable keep last 1, as ddsperf's ping/pong;
 // 2: the readers only, 3: the writers only), RCCX_BENCH_DUMP=FILE (BM_ServeRequestAckWireListener
 // writes each measured round trip there, "start_ns round_trip_ns" a line, start on
-// CLOCK_MONOTONIC as the serve's ticks: scripts/roundtrip-phases finds which of them were slow).
+// CLOCK_MONOTONIC as the serve's ticks: scripts/roundtrip-phases finds which of them were slow),
+// RCCX_BENCH_WIRE_STANDIN=1 (the wire cases against the stand-in responder, not the serve: with
+// RCCX_BENCH_LISTENER=1 as well, what the serve adds to a listener's round trip).
 #include <benchmark/benchmark.h>
 #include <fcntl.h>
 #include <signal.h>
@@ -575,7 +577,13 @@ struct WireProgram {
   }
   /// Starts the serve and waits for it to match: "" when ready, else why the case skips.
   std::string start(std::uint32_t domain) {
-    serve = start_serve(domain, "puma");
+    // A diagnosis: the stand-in responder instead of the serve (what the serve adds).
+    if (env_long("RCCX_BENCH_WIRE_STANDIN", 0) != 0) {
+      serve =
+          std::make_unique<Child>(std::vector<std::string>{"responder", std::to_string(domain)});
+    } else {
+      serve = start_serve(domain, "puma");
+    }
     if (!serve) return kNoServe;
     if (!wait_for(
             [&] { return writer_matches(requests.get()) > 0 && reader_matches(acks.get()) > 0; },
@@ -661,6 +669,10 @@ void BM_ServeRequestAckWireListener(benchmark::State& state) {
     std::chrono::steady_clock::time_point t0;
     std::atomic<long> sent{0};  // the request in flight
     std::atomic<bool> done{false};
+    // Who heartbeats: the main thread until the listener answers steadily, then the listener,
+    // between round trips. Cleared by the main thread after its last beat, so that the two
+    // never write one at once.
+    std::atomic<bool> main_beats{true};
     void send() {
       const long i = sent.load() + 1;
       w->req.request = static_cast<std::uint64_t>(i);
@@ -675,6 +687,7 @@ void BM_ServeRequestAckWireListener(benchmark::State& state) {
         ns.push_back((std::chrono::steady_clock::now() - t0).count());
         at.push_back(t0.time_since_epoch().count());
       }
+      if (!main_beats.load(std::memory_order_acquire)) w->beat_if_due();
       if (i < total) {
         send();
       } else {
@@ -703,9 +716,16 @@ void BM_ServeRequestAckWireListener(benchmark::State& state) {
     long seen = 0;
     auto progress_at = std::chrono::steady_clock::now();
     std::string failed;
+    // Then this thread only watches progress, every 100 ms: its heartbeat writes and 1 ms
+    // wake-ups, beside the receive threads on 2 cores, were inside the timed round trips
+    // (ddsperf's main thread sleeps meanwhile too).
     while (!ping.done.load()) {
-      std::this_thread::sleep_for(1ms);
-      w.beat_if_due();
+      const bool beating = ping.main_beats.load(std::memory_order_relaxed);
+      std::this_thread::sleep_for(beating ? 1ms : 100ms);
+      if (beating) {
+        w.beat_if_due();
+        if (ping.sent.load() > 2) ping.main_beats.store(false, std::memory_order_release);
+      }
       const auto now = std::chrono::steady_clock::now();
       if (const long s = ping.sent.load(); s != seen) {
         seen = s;

@@ -483,8 +483,10 @@ TEST(NetServe, AKilledServeFailsTheProgramsWaitWithinTheDetectionTime) {
   }
 }
 
-TEST(NetServe, AKilledProgramsRobotStopsSmoothlyAndTheServeSaysWhy) {
-  const std::uint32_t d = domain();
+/// One attempt of the test below (a serve's overrun before the kill, which a Debug build on a
+/// loaded machine sometimes has, runs it again on a domain of its own).
+void lost_program_once(int attempt, bool& again) {
+  const std::uint32_t d = domain(attempt - 1);
   auto s = serve(d, "puma", "serve_lostprog");
   StateRecorder states(d);
   net::RemoteOptions ro;
@@ -499,6 +501,8 @@ TEST(NetServe, AKilledProgramsRobotStopsSmoothlyAndTheServeSaysWhy) {
   program.kill9();
   // The robot comes to rest: commanded joints stop changing.
   std::this_thread::sleep_for(3s);
+  // An overrun ends control at once (RTC's rule), not by the loss: nothing to judge then.
+  RETRY_OR_SKIP_ON_OVERRUN(program.err() + s->err());
   const auto v = states.of("puma");
   ASSERT_GT(v.size(), 50U);
   std::size_t kill_index = 0;
@@ -553,6 +557,10 @@ TEST(NetServe, AKilledProgramsRobotStopsSmoothlyAndTheServeSaysWhy) {
   }
   ASSERT_LT(first_stopping, rest) << "no state said stopping before the robot came to rest";
   EXPECT_EQ(v.back().status, net::RobotStatus::at_rest);
+}
+
+TEST(NetServe, AKilledProgramsRobotStopsSmoothlyAndTheServeSaysWhy) {
+  test::run_with_attempts(lost_program_once);
 }
 
 /// One attempt of the test below (net_attempts.hpp: a serve's overrun runs it again); attempt k

@@ -139,14 +139,15 @@ class RobotServer {
   /// A robot whose control an overrun ended (said and published already) starts again at rest.
   void restart_after_overruns();
   /// Fills the robots' states for send_states() (under serve_mutex_: it reads the arms).
-  void publish_states(std::int64_t now, bool last = false);
+  /// `heartbeat_pass`: this pass writes the heartbeat, and repeats the states with it.
+  void publish_states(std::int64_t now, bool last = false, bool heartbeat_pass = false);
   /// Writes what publish_states() and poll() made ready: the states, the ROS 2 joint states, the
   /// heartbeat. Outside serve_mutex_ in a pass: the request listener, which never makes these
   /// writes, answers meanwhile instead of waiting for their system calls.
   void send_states();
   void check_lost(std::int64_t now);
   /// When the middleware thread must run again with nothing arriving (steady ns): the next
-  /// heartbeat, a state to repeat, a peer's loss deadline.
+  /// heartbeat (states to repeat go with it), a peer's loss deadline.
   [[nodiscard]] std::int64_t next_wake() const noexcept;
   /// Cyclone's data-available listeners on the readers ring wake_ (from its receive thread);
   /// the request reader's answers requests itself (answer_in_receive_thread).
@@ -154,6 +155,9 @@ class RobotServer {
   /// In Cyclone's receive thread, when a request arrived: if the middleware thread is not in a
   /// pass (try_lock, never a wait), reads what arrived and answers the requests; else rings it.
   void answer_in_receive_thread() noexcept;
+  /// In Cyclone's receive thread, when a heartbeat arrived: takes the heartbeats if the
+  /// middleware thread is not in a pass (try_lock), else rings it.
+  void take_heartbeats_in_receive_thread() noexcept;
   /// Halts `l` smoothly; the events of its motions up to the last queued say `why`.
   void halt_with(Local& l, const std::string& why);
   /// `cell` is *cell_, passed in: ~Cell stops the tasks that call this, and unique_ptr::reset

@@ -36,10 +36,17 @@ inline void cpu_relax() noexcept {
 }
 }  // namespace
 
-void wait_while(Doorbell& bell, std::uint32_t seen, std::int64_t deadline_ns, int spins) noexcept {
-  for (int i = 0; i < spins; ++i) {
-    if (bell.rings.load(std::memory_order_acquire) != seen) return;
-    cpu_relax();
+void wait_while(Doorbell& bell, std::uint32_t seen, std::int64_t deadline_ns,
+                std::int64_t spin_ns) noexcept {
+  if (spin_ns > 0) {
+    const std::int64_t until = monotonic_ns() + spin_ns;
+    do {
+      // A look at the clock (vDSO, tens of ns) every few pauses.
+      for (int i = 0; i < 16; ++i) {
+        if (bell.rings.load(std::memory_order_acquire) != seen) return;
+        cpu_relax();
+      }
+    } while (monotonic_ns() < until);
   }
   // Counted as a sleeper before the last look, so that a ring after that look sees us
   // (both sides sequentially consistent).

@@ -22,15 +22,18 @@ struct Doorbell {
   }
 };
 
-/// How long a waiter spins before it sleeps: about 10 to 30 us of pause instructions, longer
-/// than a hand-over between two running tasks, far shorter than a sample period.
-inline constexpr int kSpins = 4000;
+/// How long a waiter spins before it sleeps, ns: longer than a hand-over between two running
+/// tasks, far shorter than a sample period. Bounded by time, not by a count of `pause`s: a
+/// pause takes 10 to 140 cycles by processor (18 ns on the 2-core VM of docs/PERFORMANCE.md,
+/// where 4,000 of them held a core at real-time priority for 74 us at every hand-over, and
+/// the network threads beside the control tasks waited for it).
+inline constexpr std::int64_t kSpinNs = 20'000;
 
 /// Waits while the bell still shows `seen` (from bell.load() before checking the condition),
-/// until rung or `deadline_ns` (monotonic; <= 0: no deadline), spinning `spins` times before
-/// sleeping. Spurious returns are allowed.
+/// until rung or `deadline_ns` (monotonic; <= 0: no deadline), spinning for up to `spin_ns`
+/// before sleeping. Spurious returns are allowed.
 void wait_while(Doorbell& bell, std::uint32_t seen, std::int64_t deadline_ns = 0,
-                int spins = kSpins) noexcept;
+                std::int64_t spin_ns = kSpinNs) noexcept;
 
 /// Rings the bell: wakes everyone waiting on it.
 void ring(Doorbell& bell) noexcept;

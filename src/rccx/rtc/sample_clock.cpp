@@ -58,7 +58,7 @@ void try_real_time_scheduling(std::thread& t, int priority) {
 
 // The planning level grants a simulated tick only after it has woken up; spinning for it would
 // keep the processor it needs busy.
-constexpr int kSpinsForGrant = 0;
+constexpr std::int64_t kSpinNsForGrant = 0;
 
 }  // namespace
 
@@ -183,7 +183,7 @@ bool SampleClock::wait_granted(std::uint32_t k, std::int64_t& tick_ns) noexcept 
     const std::uint32_t seen = comm_bell_.load();
     if (stop_.load(std::memory_order_acquire)) return false;
     if (reached(granted_.load(std::memory_order_acquire), k)) break;
-    wait_while(comm_bell_, seen, 0, kSpinsForGrant);
+    wait_while(comm_bell_, seen, 0, kSpinNsForGrant);
   }
   tick_ns = simulated_now_ns_.load(std::memory_order_relaxed);
   return true;
