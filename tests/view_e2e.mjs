@@ -84,6 +84,16 @@ async function openPage(browser, url, errors, viewport = defaultSize) {
   return page;
 }
 
+/// After a resize the page lays itself out on its next frames: waits until the 3D canvas is
+/// inside the new viewport (up to 10 s: a loaded machine's browser is slow to), then
+/// checkLayout judges the whole layout.
+async function settle(page) {
+  await page.waitForFunction(() => {
+    const r = document.querySelector('#scene canvas').getBoundingClientRect();
+    return r.right <= innerWidth + 0.5 && r.bottom <= innerHeight + 0.5;
+  }, null, { timeout: 10000 }).catch(() => {});
+}
+
 /// The page fits its window: no horizontal (nor vertical) scrollbar, the 3D canvas whole and
 /// inside the viewport, the plots' pane inside it too.
 async function checkLayout(page, what) {
@@ -200,7 +210,7 @@ try {
   await checkLayout(page, 'the live page');
   await page.screenshot({ path: join(artifacts, 'view-live.png') });
   await page.setViewportSize({ width: 800, height: 600 });
-  await page.waitForTimeout(300);
+  await settle(page);
   await checkLayout(page, 'the live page at 800 x 600');
   await page.screenshot({ path: join(artifacts, 'view-live-800x600.png') });
   check(errors.length === 0, `no console error (${errors.join('; ') || 'none'})`);
@@ -248,7 +258,7 @@ try {
   await checkLayout(rpage, 'the replay');
   await rpage.screenshot({ path: join(artifacts, 'view-replay.png') });
   await rpage.setViewportSize({ width: 800, height: 600 });
-  await rpage.waitForTimeout(300);
+  await settle(rpage);
   await checkLayout(rpage, 'the replay at 800 x 600');
   check(await rpage.isVisible('#slider'), 'the replay\'s slider is visible at 800 x 600');
   check(rerrors.length === 0, `no console error in the replay (${rerrors.join('; ') || 'none'})`);
