@@ -166,7 +166,10 @@ TEST(CliOptions, ReportRunsForSecondsWhateverEvery) {
   r = rccx_run("report --robot puma560 --realtime --period 10ms --seconds 1 --every 5");
   const double wall =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  EXPECT_EQ(r.exit_code, 0) << r.out;
+  // A machine that stalls may overrun a real-time period: the report restarts control, says so
+  // and ends with 1. The option is judged either way.
+  const bool overran = r.out.find("control was restarted") != std::string::npos;
+  EXPECT_EQ(r.exit_code, overran ? 1 : 0) << r.out;
   EXPECT_LT(wall, 3.0) << "an interval longer than the run must not extend it\n" << r.out;
   ASSERT_FALSE(report_times(r.out).empty()) << r.out;
   EXPECT_NEAR(report_times(r.out).back(), 1.0, 0.05) << r.out;
