@@ -545,11 +545,7 @@ void RobotServer::answer_in_receive_thread() noexcept {
     read_frames(now);
     answered_in_listener_ += read_requests(now);
   } catch (const std::exception& e) {  // an answer not written: the serve stops, saying why
-    {
-      const std::lock_guard lock(failure_mutex_);
-      failure_ = e.what();
-    }
-    stop_.store(true);
+    stop_with(e);
   }
   // The events and states an answer leads to follow the control task's ticks, which ring the
   // middleware thread; a newly attached program's loss deadline is its own (check_lost). No ring
@@ -570,13 +566,17 @@ void RobotServer::take_heartbeats_in_receive_thread() noexcept {
   try {
     read_heartbeats(steady_ns());
   } catch (const std::exception& e) {  // a program's first heartbeat could not be recorded
-    {
-      const std::lock_guard lock(failure_mutex_);
-      failure_ = e.what();
-    }
-    stop_.store(true);
+    stop_with(e);
     rtc::detail::ring(wake_);
   }
+}
+
+void RobotServer::stop_with(const std::exception& e) noexcept {
+  {
+    const std::lock_guard lock(failure_mutex_);
+    failure_ = e.what();
+  }
+  stop_.store(true);
 }
 
 std::int64_t RobotServer::next_wake() const noexcept {

@@ -158,6 +158,8 @@ class RobotServer {
   /// In Cyclone's receive thread, when a heartbeat arrived: takes the heartbeats if the
   /// middleware thread is not in a pass (try_lock), else rings it.
   void take_heartbeats_in_receive_thread() noexcept;
+  /// From a receive-thread listener that failed: records why and stops the serve.
+  void stop_with(const std::exception& e) noexcept;
   /// Halts `l` smoothly; the events of its motions up to the last queued say `why`.
   void halt_with(Local& l, const std::string& why);
   /// `cell` is *cell_, passed in: ~Cell stops the tasks that call this, and unique_ptr::reset
