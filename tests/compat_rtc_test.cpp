@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <csignal>
+#include <cstdio>
 #include <cstdlib>
 #include <string>
 #include <thread>
@@ -70,6 +71,23 @@ class CompatRtc : public ::testing::Test {
     if (rccx::compat::rtc_session() != nullptr) rtc_close(0);
     unsetenv("RCCX_CLOCK");
     unsetenv("RCCX_ROBOT");
+  }
+
+  /// Runs a real-time scenario (it returns true when control overran its period) up to 3 times,
+  /// each from a fresh fixture: this virtual machine has stalled even SCHED_FIFO tasks for more
+  /// than a 28 ms period (59 ms seen), and one such stall says nothing of rccx. False when every
+  /// attempt overran: the caller then skips (without SCHED_FIFO) or fails.
+  template <class Scenario>
+  bool held_its_period(Scenario once) {
+    constexpr int kAttempts = 3;
+    for (int attempt = 1; attempt <= kAttempts; ++attempt) {
+      if (!once()) return true;
+      std::printf("[ overrun  ] attempt %d of %d: control overran its 28 ms period\n", attempt,
+                  kAttempts);
+      TearDown();
+      SetUp();
+    }
+    return false;
   }
 };
 
@@ -299,35 +317,45 @@ TEST_F(CompatRtc, CtrlCWithoutUserHangupEndsControlWithUserInterrupt) {
 }
 
 TEST_F(CompatRtc, RealTimeABusyLoopOnTerminateSeesControlEnd) {
-  setenv("RCCX_CLOCK", "real", 1);
-  ASSERT_EQ(rtc_open(), RTC_OK);
-  ramp_joint = 2;
-  ramp_target = how.range[2] + 5.0;  // past the limit: the library ends control
-  ramp_step = 2.0;                   // mm a sample (28 ms): about 0.6 s to get there
-  const auto start = std::chrono::steady_clock::now();
-  ASSERT_EQ(rtc_control(fn(ramp_fn1), fn(ramp_fn2)), RTC_OK);
-  // The 1983 program's `while (!terminate) ;`, read atomically here (ThreadSanitizer).
-  while (terminate_now() == 0 &&
-         std::chrono::steady_clock::now() - start < std::chrono::seconds(10)) {
-  }
-  if (terminate_now() == RTC_TERM_OVERRUN) {
-    RCCX_SKIP_UNLESS_FIFO("control overran its 28 ms period before the ramp reached the limit");
+  std::chrono::steady_clock::duration took{};
+  const bool held = held_its_period([&] {
+    setenv("RCCX_CLOCK", "real", 1);
+    if (rtc_open() != RTC_OK) return false;  // judged below: terminate stays 0
+    ramp_joint = 2;
+    ramp_target = how.range[2] + 5.0;  // past the limit: the library ends control
+    ramp_step = 2.0;                   // mm a sample (28 ms): about 0.6 s to get there
+    const auto start = std::chrono::steady_clock::now();
+    if (rtc_control(fn(ramp_fn1), fn(ramp_fn2)) != RTC_OK) return false;
+    // The 1983 program's `while (!terminate) ;`, read atomically here (ThreadSanitizer).
+    while (terminate_now() == 0 &&
+           std::chrono::steady_clock::now() - start < std::chrono::seconds(10)) {
+    }
+    took = std::chrono::steady_clock::now() - start;
+    return terminate_now() == RTC_TERM_OVERRUN;
+  });
+  if (!held) {
+    RCCX_SKIP_UNLESS_FIFO(
+        "control overran its 28 ms period before the ramp reached the limit, 3 times");
   }
   EXPECT_EQ(terminate_now(), RTC_TERM_TARGET_POSITION);
-  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(5));
+  EXPECT_LT(took, std::chrono::seconds(5));
   EXPECT_EQ(rtc_release(0), RTC_E_TERMINATED);
   EXPECT_EQ(rtc_close(0), RTC_OK);
 }
 
 TEST_F(CompatRtc, RealTimeRtcWaitSleepsWhileControlRuns) {
-  setenv("RCCX_CLOCK", "real", 1);
-  ASSERT_EQ(control(fn(ramp_fn1), nullptr), RTC_OK);
-  const auto start = std::chrono::steady_clock::now();
-  const long wait_code = rtc_wait(300.);
-  const double waited =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (terminate_now() == RTC_TERM_OVERRUN) {
-    RCCX_SKIP_UNLESS_FIFO("control overran its 28 ms period during the wait");
+  long wait_code = 0;
+  double waited = 0.0;
+  const bool held = held_its_period([&] {
+    setenv("RCCX_CLOCK", "real", 1);
+    if (control(fn(ramp_fn1), nullptr) != RTC_OK) return false;
+    const auto start = std::chrono::steady_clock::now();
+    wait_code = rtc_wait(300.);
+    waited = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return terminate_now() == RTC_TERM_OVERRUN;
+  });
+  if (!held) {
+    RCCX_SKIP_UNLESS_FIFO("control overran its 28 ms period during the wait, 3 times");
   }
   EXPECT_EQ(wait_code, RTC_OK);
   EXPECT_GE(waited, 0.29);
@@ -337,14 +365,18 @@ TEST_F(CompatRtc, RealTimeRtcWaitSleepsWhileControlRuns) {
 }
 
 TEST_F(CompatRtc, RealTimeTerminateSetInFn2IsKeptAndSeenAfterTheWait) {
-  setenv("RCCX_CLOCK", "real", 1);
-  ramp_target = 1.0;
-  ramp_step = 0.001;
-  stop_after = 10;
-  ASSERT_EQ(control(fn(ramp_fn1), fn(ramp_fn2)), RTC_OK);
-  const long ended = rtc_wait_terminated(5000.);
-  if (ended == RTC_TERM_OVERRUN) {
-    RCCX_SKIP_UNLESS_FIFO("control overran its 28 ms period before fn2 set terminate");
+  long ended = 0;
+  const bool held = held_its_period([&] {
+    setenv("RCCX_CLOCK", "real", 1);
+    ramp_target = 1.0;
+    ramp_step = 0.001;
+    stop_after = 10;
+    if (control(fn(ramp_fn1), fn(ramp_fn2)) != RTC_OK) return false;
+    ended = rtc_wait_terminated(5000.);
+    return ended == RTC_TERM_OVERRUN;
+  });
+  if (!held) {
+    RCCX_SKIP_UNLESS_FIFO("control overran its 28 ms period before fn2 set terminate, 3 times");
   }
   EXPECT_EQ(ended, RTC_TERM_USER_REQUEST);
   EXPECT_EQ(terminate, 1);
