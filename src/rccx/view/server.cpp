@@ -151,10 +151,13 @@ Server::Server(Scene scene, std::uint16_t port, ServeOptions options) {
   s.accept();
   s.tick();
   s.thread = std::thread([&s] { s.io.run(); });
-  if (s.site.options.announce) {
-    io::eprint("rccx view: open {} (Ctrl-C to stop){}\n", url(),
-               s.site.assets.empty() ? "; the front end was not built, the page will say how" : "");
-  }
+  if (s.site.options.announce) announce();
+}
+
+void Server::announce() const {
+  io::eprint(
+      "rccx view: open {} (Ctrl-C to stop){}\n", url(),
+      impl_->site.assets.empty() ? "; the front end was not built, the page will say how" : "");
 }
 
 Server::~Server() {
@@ -267,8 +270,13 @@ std::unique_ptr<Server> serve_replay(const kin::RobotModel& model, RunLog log, s
   Scene scene = Scene::of_robot(model);
   scene.title += " (replay)";
   check_log_fits(log, model);  // before the port is taken
+  // Announced once the log is in: a page opened at the address at once (a test, a user's
+  // click) would otherwise get the live page of a robot that never moves.
+  const bool announce = options.announce;
+  options.announce = false;
   auto server = std::make_unique<Server>(std::move(scene), port, std::move(options));
   server->set_replay(std::move(log));
+  if (announce) server->announce();
   return server;
 }
 

@@ -113,6 +113,11 @@ class Server {
   /// Adds a named frame (world <- frame). Planning level.
   void add_frame(SceneFrame frame);
 
+  /// Prints "rccx view: open URL (Ctrl-C to stop)" on stderr: the constructor does when
+  /// options.announce is set; a caller that still has to set the server up (serve_replay's
+  /// log) constructs it without and announces when a page opened at once sees all.
+  void announce() const;
+
   [[nodiscard]] std::uint16_t port() const noexcept;
   /// http://ADDRESS:PORT/
   [[nodiscard]] std::string url() const;
