@@ -217,9 +217,11 @@ class Watch {
 class LocalWatch final : public Watch {
  public:
   /// Before c.start(): the closest approach is read from every tick's collision world.
+  /// The closest approach is shared with the observer: the cell (destroyed after the watch)
+  /// may still run ticks while it stops.
   LocalWatch(cell::Cell& c, const Geometry& g) : c_(c), g_(g) {
-    c_.set_cycle_observer([this](std::uint32_t) {
-      closest_m_ = std::min(closest_m_, c_.collision_world().min_distance(0, 1).distance_m);
+    c_.set_cycle_observer([&c, closest = closest_m_](std::uint32_t) {
+      *closest = std::min(*closest, c.collision_world().min_distance(0, 1).distance_m);
     });
   }
 
@@ -253,7 +255,7 @@ class LocalWatch final : public Watch {
   bool controlling() override {
     return c_.session("puma").controlling() && c_.session("microbo").controlling();
   }
-  [[nodiscard]] std::optional<double> closest_m() const override { return closest_m_; }
+  [[nodiscard]] std::optional<double> closest_m() const override { return *closest_m_; }
   [[nodiscard]] std::optional<std::uint64_t> collision_stops() const override {
     return c_.collision_stops();
   }
@@ -281,7 +283,8 @@ class LocalWatch final : public Watch {
   };
   cell::Cell& c_;
   Geometry g_;
-  double closest_m_ = std::numeric_limits<double>::infinity();
+  std::shared_ptr<double> closest_m_ =
+      std::make_shared<double>(std::numeric_limits<double>::infinity());
   std::array<Reading, 16> recent_{};
   std::size_t next_ = 0;
   double microbo_last_s_ = -1.0;

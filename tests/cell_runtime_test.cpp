@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -205,6 +206,115 @@ TEST(CellRuntime, TheMicroboFollowsAFrameThePumaMoves) {
   EXPECT_GT(compared, 100U);
   EXPECT_GT(travel_m, 0.029) << "the follower did not move with the leader";
   EXPECT_LT(worst_m, 1e-3) << "commanded tool points apart by up to " << worst_m * 1e3 << " mm";
+}
+
+// A Cartesian line onto a frame another robot moves is straight relative to that frame: the
+// Microbo, held 20 mm above what the PUMA carries, is lowered onto it while the PUMA carries it
+// along y at 20 mm/s (issue 28: the line started where the frame had been when it was
+// planned, and swept along its way).
+TEST(CellRuntime, ALineOntoAFrameThePumaMovesIsStraightRelativeToIt) {
+  const auto c = cell::Cell::load(kCvarl);
+  struct Sample {
+    double t_s;
+    math::Vec3 p;
+  };
+  std::vector<Sample> leader, follower;
+  leader.reserve(20000);
+  follower.reserve(5000);
+  double leader_t = -1.0, follower_t = -1.0;
+  c->set_cycle_observer([&](std::uint32_t) {
+    const rccl::TrajectoryGenerator& gp = c->robot("puma").generator();
+    const rccl::TrajectoryGenerator& gm = c->robot("microbo").generator();
+    if (gp.last_setpoint().size() == 6 && gp.last_setpoint_time_s() != leader_t &&
+        leader.size() < leader.capacity()) {
+      leader_t = gp.last_setpoint_time_s();
+      leader.push_back({leader_t, tool_point(*c, "puma", gp.last_setpoint())});
+    }
+    if (gm.last_setpoint().size() == 6 && gm.last_setpoint_time_s() != follower_t &&
+        follower.size() < follower.capacity()) {
+      follower_t = gm.last_setpoint_time_s();
+      follower.push_back({follower_t, tool_point(*c, "microbo", gm.last_setpoint())});
+    }
+  });
+  c->start();
+  rccl::Manipulator& puma = c->robot("puma");
+  rccl::Manipulator& microbo = c->robot("microbo");
+
+  constexpr double kHeight_m = 0.02, kDescent_m_per_s = 0.01;
+  const math::Transform grasp_offset = math::Transform::translation(0.15, 0.0, 0.0);
+  // Tools point down: their z is the world's -z.
+  const math::Transform up = math::Transform::translation(0.0, 0.0, -kHeight_m);
+  const math::Vec3 p0 = kAbove + math::Vec3{-0.05, -0.05, 0.0};
+  puma.set_velocity(0.05, 0.5);
+  microbo.set_velocity(0.05, 0.5);
+  puma.move(world_position(*c, "puma", "P0", down_at(p0)));
+  microbo.move(world_position(*c, "microbo", "M0", down_at(p0) * grasp_offset * up));
+  ASSERT_EQ(puma.waitfor(rccl::Manipulator::completed(), 20s), rccl::WaitResult::reached)
+      << failures_of(puma);
+  ASSERT_EQ(microbo.waitfor(rccl::Manipulator::completed(), 20s), rccl::WaitResult::reached)
+      << failures_of(microbo);
+
+  // T6 TOOL = BASE_INV(microbo) PUMA_TOOL GRASP_OFFSET UP, then the same without UP.
+  const auto t6 = rccl::t6();
+  const auto tool = rccl::constant("TOOL", c->model().find_robot("microbo")->tool.value());
+  const auto puma_tool = c->in_base_of("microbo", c->tool_frame("puma"));
+  const auto grasp = rccl::constant("GRASP_OFFSET", grasp_offset);
+  const auto above =
+      rccl::Position::make("ABOVE", {t6, tool}, {puma_tool, grasp, rccl::constant("UP", up)}, tool);
+  const auto on = rccl::Position::make("ON", {t6, tool}, {puma_tool, grasp}, tool);
+  microbo.set_mode(rccl::Mode::cartesian);
+  ASSERT_EQ(microbo.waitfor(microbo.move(above).end(), 20s), rccl::WaitResult::reached)
+      << failures_of(microbo);
+
+  // The PUMA carries it 100 mm along y at 20 mm/s; once under way, the Microbo goes down.
+  puma.set_mode(rccl::Mode::cartesian);
+  puma.set_velocity(0.02, 0.5);
+  const rccl::Motion carry =
+      puma.move(world_position(*c, "puma", "PY", down_at(p0 + math::Vec3{0.0, 0.1, 0.0})));
+  ASSERT_EQ(puma.waitfor(carry.start(), 20s), rccl::WaitResult::reached) << failures_of(puma);
+  c->wait_for(1s);
+  microbo.set_velocity(kDescent_m_per_s, 0.5);
+  const rccl::Motion down = microbo.move(on);
+  ASSERT_EQ(microbo.waitfor(down.end(), 20s), rccl::WaitResult::reached) << failures_of(microbo);
+  const double down_from_s = microbo.report(down).start_s;
+  const double down_to_s = microbo.report(down).end_s;
+  ASSERT_EQ(puma.waitfor(carry.end(), 20s), rccl::WaitResult::reached) << failures_of(puma);
+  EXPECT_GT(puma.report(carry).end_s, down_to_s) << "the PUMA stopped before the descent ended";
+  EXPECT_TRUE(microbo.failures().empty()) << failures_of(microbo);
+
+  // Each follower setpoint from the leader's tool at the same instant (interpolated between
+  // its setpoints), through the grasp offset: on the vertical line, at most the set speed.
+  double off_line_m = 0.0, fastest_m_per_s = 0.0, lowest_m = kHeight_m;
+  std::size_t compared = 0;
+  math::Vec3 previous;
+  double previous_t = -1.0;
+  for (const Sample& f : follower) {
+    if (f.t_s < down_from_s || f.t_s > down_to_s) continue;
+    const auto it = std::lower_bound(leader.begin(), leader.end(), f.t_s,
+                                     [](const Sample& s, double x) { return s.t_s < x; });
+    if (it == leader.begin() || it == leader.end()) continue;
+    const double u = (f.t_s - (it - 1)->t_s) / (it->t_s - (it - 1)->t_s);
+    const math::Vec3 frame = (it - 1)->p + (it->p - (it - 1)->p) * u + math::Vec3{0.15, 0.0, 0.0};
+    const math::Vec3 rel = f.p - frame;
+    off_line_m = std::max(off_line_m, std::hypot(rel.x, rel.y));
+    lowest_m = std::min(lowest_m, rel.z);
+    if (previous_t >= 0.0) {
+      fastest_m_per_s = std::max(fastest_m_per_s, (rel - previous).norm() / (f.t_s - previous_t));
+    }
+    previous = rel;
+    previous_t = f.t_s;
+    ++compared;
+  }
+  RecordProperty("off_line_mm", std::to_string(off_line_m * 1e3));
+  RecordProperty("fastest_mm_per_s", std::to_string(fastest_m_per_s * 1e3));
+  std::printf(
+      "descent onto the PUMA's frame: %zu samples, %.3f mm off the line, lowest %.3f mm, "
+      "fastest %.2f mm/s relative to it\n",
+      compared, off_line_m * 1e3, lowest_m * 1e3, fastest_m_per_s * 1e3);
+  EXPECT_GT(compared, 40U);
+  EXPECT_LT(lowest_m, 0.5e-3) << "it did not reach the frame";
+  EXPECT_LT(off_line_m, 0.5e-3);
+  EXPECT_LE(fastest_m_per_s, kDescent_m_per_s * 1.05);
 }
 
 TEST(CellRuntime, TwoArmsDrivenTowardsEachOtherStopOutsideTheMargin) {

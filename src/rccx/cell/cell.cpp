@@ -14,6 +14,12 @@ namespace rccx::cell {
 
 namespace {
 
+/// A leader's published tool frame is extrapolated with its acceleration for at most this long
+/// (s): past a reader's pipeline (two periods) only a prediction for planning asks further.
+constexpr double kAccelerationFor_s = 0.25;
+/// How far ahead (or back) a planning prediction extrapolates it at all (s).
+constexpr double kPredictionHorizon_s = 10.0;
+
 rtc::SessionOptions group_options(const CellModel& m, const CellOptions& o) {
   rtc::SessionOptions so;
   so.period = m.base_period;
@@ -438,9 +444,24 @@ rccl::TransformPtr Cell::tool_frame(std::string_view leader) const {
     // Extrapolated to the time the reader's setpoint is for (a follower sampled more slowly,
     // or later in the tick); a reader without a time (the planning level) takes it as it is.
     const double dt = ctx.t_s - s.t_s;
-    if (ctx.how == nullptr || !(std::abs(dt) < 0.25)) return s.pose;
+    if (ctx.how == nullptr) return s.pose;
+    if (!(std::abs(dt) < kAccelerationFor_s)) {
+      // Beyond the pipeline's reach only a generator planning ahead asks (where a line onto
+      // the frame will start, at its via time), and only a leader that goes on publishing
+      // (one that has come to rest stops: its last sample, a while old, is where it stays)
+      // is predicted: at its velocity, the acceleration (a moment's: one that brakes to rest
+      // would run it backwards) counted only for the pipeline's reach, so that the
+      // prediction joins the one within it.
+      const double age_s = ctx.sample_time_s() - s.t_s;
+      if (!ctx.predicted || !(age_s < kAccelerationFor_s) ||
+          !(std::abs(dt) < kPredictionHorizon_s)) {
+        return s.pose;
+      }
+    }
+    const double accelerating = std::clamp(dt, -kAccelerationFor_s, kAccelerationFor_s);
     math::Transform p = s.pose;
-    p.p = p.p + s.velocity_m_per_s * dt + s.acceleration_m_per_s2 * (dt * dt / 2.0);
+    p.p = p.p + s.velocity_m_per_s * dt +
+          s.acceleration_m_per_s2 * (accelerating * accelerating / 2.0);
     p.R = rotate(p.R, s.angular_velocity_rad_s, dt);
     return p;
   });

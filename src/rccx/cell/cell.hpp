@@ -23,7 +23,9 @@
 // The control task publishes every robot's commanded T6 TOOL (in the world, with its linear
 // velocity and acceleration and its angular velocity) after each tick through a seqlock; a
 // reader extrapolates it to the time its own setpoint is for (up to its pipeline of two
-// periods ahead), so a follower sampled at another rate does not lag.
+// periods ahead), so a follower sampled at another rate does not lag; a generator planning a
+// line onto it predicts it to the line's via time (at its velocity; a leader that has come to
+// rest, and stopped publishing, where it is), so that the line starts where the frame will be.
 //
 // Safety between arms: after every tick the control task puts every robot's next setpoint
 // into a CollisionWorld (the whole arm as capsules: links, joints, the cell file's shapes and

@@ -108,13 +108,20 @@ void TrajectoryGenerator::join_or_end(const SampleContext& ctx) {
   // rendezvous always starts from rest, where the others can wait for it.
   Text why{};
   const MotionRequest* w = queue_.waiting();
-  const bool may_join = w != nullptr && w->together == nullptr &&
-                        (w->gates == 0 || queue_.gate_state(why) == GateState::open);
+  // A stop (dwell) is never blended: the motion before it comes to rest, and the one after it
+  // starts from rest, so that the arm is still for the stop's whole time.
+  const bool may_join = w != nullptr && w->together == nullptr && w->kind != RequestKind::dwell &&
+                        !cur.dwell && (w->gates == 0 || queue_.gate_state(why) == GateState::open);
   if (!loop_.has_next && may_join && t < te - cur.stop_tau - eps) {
     if (build(*w, ctx, te)) {
       queue_.join();
       loop_.next_tau = planner_.transition_tau(
           cur, loop_.next, trajectory::blend_between(cur, &loop_.next), te, ctx);
+      // Planning may have slowed it: a joint line onto a moving goal aims anew at its end.
+      for (int round = 0; round < 2 && builder_.aim_at_end(loop_.next, ctx); ++round) {
+        loop_.next_tau = planner_.transition_tau(
+            cur, loop_.next, trajectory::blend_between(cur, &loop_.next), te, ctx);
+      }
       // Decided late: the window must not have begun already.
       loop_.next_tau = std::min(loop_.next_tau, te - t);
     }
@@ -229,18 +236,29 @@ void TrajectoryGenerator::start_waiting(const SampleContext& ctx, double t) {
     segments_.pose_at(loop_.cur, ctx, 1.0, p);
     if (goal_track_.jumped(loop_.cur.position)) rest_at(loop_.last_q);
   }
-  // From rest: the transition begins now; the straight part tau later.
+  // From rest: the transition begins now; the straight part tau later (a stop's at once: the
+  // arm is at rest already).
   if (!build(r, ctx, t)) return;
   queue_.started();
   Segment& next = loop_.next;
-  const double tau =
-      planner_.transition_tau(loop_.cur, next, trajectory::blend_between(loop_.cur, &next), t, ctx);
-  if (rv != nullptr && rv->end_together()) {
-    // Slowed to the slowest: the straight part takes the time left between both transitions
-    // (planned for the faster motion, so they stay within the bounds for the slower one).
-    next.T = std::max(next.T, rv->duration_s() - tau - next.stop_tau);
-  }
-  next.ts = t + tau;
+  const auto plan = [&] {
+    next.ts = t;
+    const double tau_in =
+        next.dwell ? 0.0
+                   : planner_.transition_tau(loop_.cur, next,
+                                             trajectory::blend_between(loop_.cur, &next), t, ctx);
+    if (rv != nullptr && rv->end_together()) {
+      // Slowed to the slowest: the straight part takes the time left between both transitions
+      // (planned for the faster motion, so they stay within the bounds for the slower one).
+      next.T = std::max(next.T, rv->duration_s() - tau_in - next.stop_tau);
+    }
+    next.ts = t + tau_in;
+    return tau_in;
+  };
+  double tau = plan();
+  // Its straight part starts tau later and planning may have slowed it: a joint line onto a
+  // moving goal aims anew at where the goal will be at its end.
+  for (int round = 0; round < 2 && builder_.aim_at_end(next, ctx); ++round) tau = plan();
   begin_transition(ctx, t + tau, tau, next.blend_in, true);
 }
 

@@ -34,6 +34,10 @@ struct Segment {
   Kind kind = Kind::rest;
   bool resting = false;  ///< cartesian: r stays 1 (tracking a moving goal)
   const Position* position = nullptr;
+  /// RCCL's stop(ms): the arm at rest (on a moving goal, tracking it) for exactly T, never
+  /// blended with the motions either side: the one before stops first, the one after starts
+  /// from rest when it is over (docs/RCCL.md, "stop(ms)").
+  bool dwell = false;
   /// A dwell (stop) on a moving goal: it tracks the position of the motion before it, which
   /// it does not own (that motion's end was counted already).
   bool borrowed_position = false;

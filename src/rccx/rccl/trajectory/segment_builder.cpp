@@ -39,34 +39,68 @@ std::optional<Failure> SegmentBuilder::build(const MotionRequest& r, const Sampl
   const Position& pos = *r.position;
   if (auto f = check_goal(pos, s)) return f;
   choose_configuration(s, via.q);
+  // The goal where it will be at the via time, as the arm's pose there is: the line starts at
+  // F(ts) = G(ts) D(0), so a moving goal taken now would shift its start by the goal's motion
+  // over the look-ahead (a part on a belt: the descent onto it swept along the belt).
   Pose goal;
-  segments().pose_at(s, ctx, 1.0, goal);  // drive is identity so far: frame = goal
-  const math::Transform frameB = via.t6 * goal.tool;
-  const math::Transform offset = goal.goal.inverse_times(frameB);
-  // Time from the tool's speeds along the motion (RCCL computes it so in both modes).
-  const double by_speed =
-      std::max(offset.p.norm() / std::max(s.settings.translation_m_per_s, 1e-9),
-               rotation_angle(offset.R) / std::max(s.settings.rotation_rad_per_s, 1e-9));
+  segments().pose_at(s, at_time(ctx, t_via), 1.0, goal);  // drive is identity so far: F = G
   Timing timing;
   if (s.settings.mode == Mode::joint) {
     if (auto f = joint_goal(pos, goal, s, timing)) return f;
+    s.T = segment_time(s, via.t6, goal, timing);
+    // A joint line ends on fixed joints: onto a moving goal, those of the goal where it will be
+    // when the line ends (its time depends on them: a few rounds settle it).
+    for (int round = 0; round < 3 && pos.moves() && !pos.in_joints(); ++round) {
+      segments().pose_at(s, at_time(ctx, t_via + s.T), 1.0, goal);
+      timing = Timing{};
+      if (auto f = joint_goal(pos, goal, s, timing)) return f;
+      s.T = segment_time(s, via.t6, goal, timing);
+    }
   } else {
+    const math::Transform frameB = via.t6 * goal.tool;
     s.kind = Segment::Kind::cartesian;
-    s.drive = math::DriveTransform(offset, math::Transform::identity());
+    s.drive = math::DriveTransform(goal.goal.inverse_times(frameB), math::Transform::identity());
     s.start_in_goal = s.drive.at(0.0);
     s.fixed_start = segments().loop().cur.kind == Segment::Kind::rest && pos.moves();
     s.start_world = frameB;
     s.start_goal_p = goal.goal.p;
-    if (auto f = walk_line(s, ctx, via.q, timing)) return f;
-  }
-  s.T = s.settings.segment_time_s > 0.0 ? s.settings.segment_time_s : by_speed;
-  s.T = std::max({s.T, timing.by_joints, timing.by_acceleration, s.settings.transition_time_s,
-                  2.0 * model().options.period_s});
-  if (s.kind == Segment::Kind::cartesian) {
+    // Walked as it stands at its start (the seed is the arm there); the goal's own motion
+    // along it is sampled by stretch_line, at the times the loop will run it.
+    if (auto f = walk_line(s, at_time(ctx, t_via), via.q, timing)) return f;
+    s.T = segment_time(s, via.t6, goal, timing);
     if (auto f = stretch_line(s, ctx, via.q)) return f;
   }
   plan_stop(s, ctx, timing.end_step);
   return std::nullopt;
+}
+
+bool SegmentBuilder::aim_at_end(Segment& s, const SampleContext& ctx) const {
+  if (s.kind != Segment::Kind::joint || s.position == nullptr || s.borrowed_position ||
+      !s.position->moves() || s.position->in_joints()) {
+    return false;
+  }
+  Pose goal;
+  segments().pose_at(s, at_time(ctx, s.ts + s.T), 1.0, goal);
+  kin::JointVector q1;
+  kin::IkStatus why = kin::IkStatus::ok;
+  if (!segments().solve(s, goal.t6, s.q1, q1, why)) return false;
+  if (model().kin.model().first_joint_outside_limits(q1, kin::kLimitTolerance) >= 0) return false;
+  s.q1 = q1;
+  plan_stop(s, ctx, {});
+  return true;
+}
+
+double SegmentBuilder::segment_time(const Segment& s, const math::Transform& t6_via,
+                                    const Pose& goal, const Timing& timing) const {
+  // From the tool's speeds along the motion (RCCL computes it so in both modes), unless the
+  // motion's time is set, and never less than the joints and the transitions need.
+  const math::Transform offset = goal.goal.inverse_times(t6_via * goal.tool);
+  const double by_speed =
+      std::max(offset.p.norm() / std::max(s.settings.translation_m_per_s, 1e-9),
+               rotation_angle(offset.R) / std::max(s.settings.rotation_rad_per_s, 1e-9));
+  const double T = s.settings.segment_time_s > 0.0 ? s.settings.segment_time_s : by_speed;
+  return std::max({T, timing.by_joints, timing.by_acceleration, s.settings.transition_time_s,
+                   2.0 * model().options.period_s});
 }
 
 SegmentBuilder::Via SegmentBuilder::via_point(const SampleContext& ctx, double t_via) const {
@@ -105,8 +139,12 @@ void SegmentBuilder::dwell(const MotionRequest& r, Segment& s) const {
     s.configuration = cur.configuration;
     s.has_configuration = cur.has_configuration;
   }
-  s.T = std::max(r.dwell_s, P);
-  s.stop_tau = base_stop_tau(s, P);
+  s.dwell = true;
+  // The arm is still for the time asked rounded up to whole samples, at least 3: the sample it
+  // comes to rest on (the motion before stopped there) and the one it leaves from (the motion
+  // after starts from rest) are still too, besides the dwell's own. Nothing to stop.
+  s.T = std::max(std::ceil(r.dwell_s / P - 1e-9) - 2.0, 1.0) * P;
+  s.stop_tau = 0.0;
 }
 
 std::optional<Failure> SegmentBuilder::check_goal(const Position& pos, Segment& s) const {

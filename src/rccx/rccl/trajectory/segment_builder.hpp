@@ -33,6 +33,11 @@ class SegmentBuilder {
   /// why the motion cannot be run (s is then incomplete).
   std::optional<Failure> build(const MotionRequest& r, const SampleContext& ctx, double t_via,
                                Segment& s) const;
+  /// A joint segment onto a moving goal, once planning has set its start and time: its end
+  /// joints become those of the goal where it will be at ts + T, and its stop is planned anew.
+  /// False (nothing changed) for any other segment, or when that pose has no solution (the
+  /// end built stands; the loop's guards judge the goal as it comes).
+  bool aim_at_end(Segment& s, const SampleContext& ctx) const;
 
  private:
   /// Where the arm will be at the via point: joints and T6.
@@ -51,6 +56,10 @@ class SegmentBuilder {
   [[nodiscard]] const SegmentEvaluator& segments() const noexcept { return planner_.segments(); }
   [[nodiscard]] const GeneratorModel& model() const noexcept { return segments().model(); }
   Via via_point(const SampleContext& ctx, double t_via) const;
+  /// Segment s's time from the tool's speeds (or its set time), at least what the joints and
+  /// the transitions need (s); `goal`: its goal where the line ends, `t6_via`: where it starts.
+  [[nodiscard]] double segment_time(const Segment& s, const math::Transform& t6_via,
+                                    const Pose& goal, const Timing& timing) const;
   void dwell(const MotionRequest& r, Segment& s) const;
   std::optional<Failure> check_goal(const Position& pos, Segment& s) const;
   void choose_configuration(Segment& s, const kin::JointVector& qB) const;

@@ -43,7 +43,8 @@ double TransitionPlanner::plan(const Segment& a, Segment& b, Blend blend, double
   // velocity needs longer than a has left, b (not started yet) is slowed down until it fits -
   // its velocity scales as 1 / T.
   // (Nor before now: a segment shorter than its transitions is joined late.)
-  const double room = a.kind == Segment::Kind::rest
+  // (A resting segment - at rest, or tracking a moving goal - has no end: all the room.)
+  const double room = a.kind == Segment::Kind::rest || a.resting
                           ? std::numeric_limits<double>::infinity()
                           : std::max(P, std::min(tB - (a.ts + a.tau_in), tB - ctx.t_s + 1e-9));
   Stretch stretch{b};
