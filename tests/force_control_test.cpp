@@ -8,10 +8,12 @@
 #include <cstdio>
 #include <cstdlib>
 #include <memory>
+#include <string>
 
 #include "rccx/hw/arm_base.hpp"
 #include "rccx/hw/simulated_arm.hpp"
 #include "rccx/kinematics/kinematics.hpp"
+#include "rccx/rccl/force_control.hpp"
 #include "rccx/rccl/manipulator.hpp"
 #include "rccx/rtc/servo_driver.hpp"
 #include "rccx/rtc/session.hpp"
@@ -161,6 +163,42 @@ TEST(ForceControl, HoldingAForceOnTheTableWhileMovingAlongItKeepsItWithinTenPerc
   for (const auto& f : r.manipulator.failures()) ADD_FAILURE() << f.message();
   EXPECT_GT(samples, 100);
   EXPECT_LT(worst, 0.10);
+}
+
+// A compliant motion that starts with the tool pressing past its limit (a stop left the command
+// 15 mm into the table: 150 N on the 10^4 N/m spring) yields toward the set force first and
+// holds it; one that cannot yield that way (only x compliant) fails after the bounded time,
+// saying so, instead of at its first sample.
+TEST(ForceControl, ACompliantMotionStartingPastItsLimitYieldsFirstOrFailsAfterTheBoundedTime) {
+  for (const bool along_z : {true, false}) {
+    SCOPED_TRACE(along_z ? "fz compliant" : "only fx compliant");
+    Rig r;
+    r.go(r.at("INTO", 0.40, 0.15, Rig::kTable_m - 0.015));  // pressing 150 N
+    const double pressing_N = 1e4 * (Rig::kTable_m - r.arm.tip().z);
+    ASSERT_GT(pressing_N, 120.0);
+    r.manipulator.set_mode(rccl::Mode::cartesian);
+    r.manipulator.set_velocity(0.02, 0.5);
+    rccl::Compliance c;
+    c.axes = along_z ? 1U << 2 : 1U << 0;
+    c.force[2] = 5.0;
+    r.manipulator.set_compliance(c);
+    const double t0 = r.session.how().time_s;
+    const rccl::Motion wipe = r.manipulator.move(r.at("END", 0.45, 0.15, Rig::kTable_m - 0.015));
+    EXPECT_EQ(r.manipulator.waitfor(wipe.end(), std::chrono::seconds(30)),
+              along_z ? rccl::WaitResult::reached : rccl::WaitResult::failed);
+    const double took_s = r.session.how().time_s - t0;
+    const double end_N = 1e4 * std::max(Rig::kTable_m - r.arm.tip().z, 0.0);
+    if (along_z) {
+      for (const auto& f : r.manipulator.failures()) ADD_FAILURE() << f.message();
+      EXPECT_NEAR(end_N, 5.0, 0.5);
+    } else {
+      ASSERT_FALSE(r.manipulator.failures().empty());
+      const std::string why(r.manipulator.failures().front().message());
+      EXPECT_NE(why.find("still exerted"), std::string::npos) << why;
+      EXPECT_NE(why.find("after yielding 1.0 s"), std::string::npos) << why;
+      EXPECT_GT(took_s, rccl::ForceControl::kYieldWithin_s);
+    }
+  }
 }
 
 TEST(ForceControl, CompliantAxesYieldToAPushAndLockedOnesDoNotMove) {

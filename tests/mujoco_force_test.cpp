@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "rccx/force/tool_load.hpp"
 #include "rccx/hw/mjcf.hpp"
@@ -309,6 +310,105 @@ TEST(MujocoForce, TheToolLoadCalibrationFindsTheToolMuJoCoCarries) {
   EXPECT_LT(left.force_N.norm(), 0.1);
   EXPECT_LT(left.torque_N_m.norm(), 0.01);
   for (const auto& f : c.m.failures()) ADD_FAILURE() << f.message();
+}
+
+}  // namespace
+}  // namespace rccx
+
+namespace rccx {
+namespace {
+
+// Issue 28: a program stops on the table by a monitor (a functional transform that ends the
+// motion, RCCL's nextmove, when the measured tool reaches the surface), then complies pressing
+// 5 N and wipes. The stop leaves the command inside the table (the arm brakes past the touch),
+// and the stiff slide presses far more than the compliance's 100 N limit: the compliant motion
+// yields first, toward the set force, instead of failing at once.
+TEST(MujocoForce, AMonitorStopOntoTheTableThenComplyAndAWipeHoldTheSetForce) {
+  constexpr double kTop_m = 0.19, kStylus_m = 0.05, kMass_kg = 0.1;  // microbo_table.json
+  rtc::SimulatedRobot robot(kin::load_robot_file(RCCX_MICROBO_TABLE));
+  rccl::Manipulator m(*robot.session);
+  m.start();
+  force::ToolLoad load;
+  load.mass_kg = kMass_kg;
+  load.com_m = {0, 0, kStylus_m / 2};
+  m.set_tool_load(load);
+  const auto tool = rccl::constant("TOOL", Transform::translation(0, 0, kStylus_m));
+  const auto at = [&](const std::string& name, const rccl::TransformPtr& extra, double x, double y,
+                      double z) {
+    Transform goal = Transform::translation(x, y, z);
+    goal.R = math::Rot3::rot_x(M_PI);  // the tool's z down
+    std::vector<rccl::TransformPtr> rhs{rccl::constant(name + "_G", goal)};
+    if (extra) rhs.push_back(extra);
+    return rccl::Position::make(name, {rccl::t6(), tool}, rhs, tool);
+  };
+  const auto go = [&](const rccl::Motion& mo) {
+    const rccl::WaitResult w = m.waitfor(mo.end(), 60s);
+    EXPECT_EQ(w, rccl::WaitResult::reached) << rccl::to_string(w);
+    for (const auto& f : m.failures()) ADD_FAILURE() << f.message();
+  };
+  // The monitor: the measured tool tip at the table's top ends the search.
+  rccl::TrajectoryGenerator& generator = m.generator();
+  const kin::Kinematics& kin = m.kinematics();
+  bool touched = false;
+  const auto monitor = rccl::functional("MON", [&](const rccl::SampleContext& ctx) {
+    if (!touched && ctx.how != nullptr && !ctx.predicted) {
+      const double tip_z =
+          (kin.forward(ctx.how->q()) * Transform::translation(0, 0, kStylus_m)).p.z;
+      if (tip_z <= kTop_m) {
+        touched = true;
+        generator.request_next();
+      }
+    }
+    return Transform::identity();
+  });
+
+  go(m.move(at("ABOVE", nullptr, 0.30, 0.0, kTop_m + 0.02)));
+  m.set_mode(rccl::Mode::cartesian);
+  m.set_velocity(0.005, 0.5);  // a slow search (at 10 mm/s the stop presses 262 N, at 20 290)
+  const rccl::Motion search = m.move(at("SEARCH", monitor, 0.30, 0.0, kTop_m - 0.03));
+  go(search);
+  ASSERT_TRUE(touched) << "the search did not reach the table";
+  const auto pressing = [&] {
+    const rtc::How h = robot.session->how();
+    const Transform t6 = kin.forward(h.q());
+    const math::Wrench ext =
+        force::at_tool(tool->value(), force::external_wrench(load, t6.R, h.force.wrench));
+    return -ext.force_N.z;
+  };
+  // The Microbo's servos push on toward the command inside the table: once the tool presses
+  // more than the compliance's 100 N limit (the issue's program met 120.7 N), comply and wipe.
+  double pressed_N = pressing();
+  for (int i = 0; i < 100 && pressed_N < 120.0; ++i) {
+    robot.session->wait_for(28ms);
+    pressed_N = pressing();
+  }
+  std::printf("after the monitor's stop the tool presses %.1f N\n", pressed_N);
+  ASSERT_GT(pressed_N, 100.0) << "the stop did not leave the tool pressing past the limit";
+  rccl::Compliance press;
+  press.axes = 1U << 2;
+  press.force[2] = 5.0;
+  m.set_compliance(press);
+  const Transform here = kin.forward(robot.session->how().q()) * tool->value();
+  m.set_velocity(0.01, 0.5);
+  const rccl::Motion wipe = m.move(at("ALONG", nullptr, 0.36, 0.0, here.p.z));
+  const double t0 = robot.session->how().time_s;
+  double sum = 0.0;
+  int samples = 0;
+  while (!m.happened(wipe.end())) {
+    robot.session->wait_for(28ms);
+    const double t = robot.session->how().time_s - t0;
+    ASSERT_LT(t, 60.0);
+    ASSERT_FALSE(robot.session->termination().ended())
+        << robot.session->termination().detail_view();
+    if (t > 1.5 && t < 4.5) {  // the steady middle of the 6 s wipe
+      sum += pressing();
+      ++samples;
+    }
+  }
+  for (const auto& f : m.failures()) ADD_FAILURE() << f.message();
+  ASSERT_GT(samples, 50);
+  std::printf("wiping: %.2f N on average over %d samples (set 5 N)\n", sum / samples, samples);
+  EXPECT_NEAR(sum / samples, 5.0, 0.5);
 }
 
 }  // namespace

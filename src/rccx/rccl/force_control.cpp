@@ -169,10 +169,26 @@ ForceControl::Outcome ForceControl::step(const rtc::How& how, std::uint64_t id,
   const Compliance& c = settings != nullptr ? settings->compliance : none;
   if (c.any()) {
     const double f = applied_.force_N.norm(), t = applied_.torque_N_m.norm();
-    if (f > c.max_force_N || t > c.max_torque_N_m) {
-      std::snprintf(why_.data(), why_.size(),
-                    "the tool exerted %.1f N, %.2f N m while compliant (limits %.1f N, %.2f N m)",
-                    f, t, c.max_force_N, c.max_torque_N_m);
+    const bool over = f > c.max_force_N || t > c.max_torque_N_m;
+    if (id != yield_motion_) {  // its first compliant sample
+      yield_motion_ = id;
+      yielding_ = over;
+      yield_since_s_ = how.time_s;
+    } else if (!over) {
+      yielding_ = false;  // from now on the limits hold
+    }
+    const double yielded_s = how.time_s - yield_since_s_;
+    if (over && !(yielding_ && yielded_s < kYieldWithin_s)) {
+      if (yielding_) {
+        std::snprintf(why_.data(), why_.size(),
+                      "the tool still exerted %.1f N, %.2f N m after yielding %.1f s from the "
+                      "start of the compliant motion (limits %.1f N, %.2f N m)",
+                      f, t, yielded_s, c.max_force_N, c.max_torque_N_m);
+      } else {
+        std::snprintf(why_.data(), why_.size(),
+                      "the tool exerted %.1f N, %.2f N m while compliant (limits %.1f N, %.2f N m)",
+                      f, t, c.max_force_N, c.max_torque_N_m);
+      }
       held_for_ = id;
       held_after_stop_ = true;
       return Outcome::overload;

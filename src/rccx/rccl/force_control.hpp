@@ -38,6 +38,10 @@ class ForceControl {
   /// exceeds this fraction of the guard's threshold.
   static constexpr double kOnsetFraction = 0.15;
   static constexpr std::size_t kContacts = 64;
+  /// A compliant motion that starts with the tool exerting more than its limits (a stop that
+  /// left the command inside a surface) yields toward the set force first: it fails only if
+  /// the force is still above the limits this long after its start, s.
+  static constexpr double kYieldWithin_s = 1.0;
 
   explicit ForceControl(const kin::Kinematics& kinematics) noexcept : kin_(kinematics) {}
 
@@ -96,8 +100,11 @@ class ForceControl {
   math::Wrench applied_;
   std::array<double, 6> offset_{}, last_good_offset_{};
   math::Transform last_tool_;
-  std::uint64_t held_for_ = 0;    ///< the offset stays as it is while motion held_for_ runs
-  bool held_after_stop_ = false;  ///< ... and at rest after it
+  std::uint64_t yield_motion_ = 0;  ///< the compliant motion the yield rule was set for
+  bool yielding_ = false;           ///< it started above the limits and has not come below yet
+  double yield_since_s_ = 0.0;      ///< its first compliant sample's time, s
+  std::uint64_t held_for_ = 0;      ///< the offset stays as it is while motion held_for_ runs
+  bool held_after_stop_ = false;    ///< ... and at rest after it
   std::array<Past, kHistory> past_{};
   std::size_t past_count_ = 0, past_next_ = 0;
   std::uint64_t past_motion_ = 0;
