@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -22,6 +23,49 @@ using namespace std::chrono_literals;
 using namespace rccx::math::literals;
 
 using namespace rccx::cell_test;
+
+/// Every new setpoint's tool point of the PUMA (the leader) and the Microbo (the follower), the
+/// control task's, recorded by the cell's cycle observer (set before start()). Shared, so that
+/// it outlives the ticks the cell's destructor may still run.
+struct ToolPoints {
+  struct Sample {
+    double t_s;
+    math::Vec3 p;
+  };
+  std::vector<Sample> leader, follower;
+  double leader_t = -1.0, follower_t = -1.0;
+  /// The leader's tool point at time t, interpolated between its setpoints; false outside them.
+  bool leader_at(double t, math::Vec3& p) const {
+    const auto it = std::lower_bound(leader.begin(), leader.end(), t,
+                                     [](const Sample& s, double x) { return s.t_s < x; });
+    if (it == leader.begin() || it == leader.end()) return false;
+    const double u = (t - (it - 1)->t_s) / (it->t_s - (it - 1)->t_s);
+    p = (it - 1)->p + (it->p - (it - 1)->p) * u;
+    return true;
+  }
+};
+
+std::shared_ptr<ToolPoints> record_tool_points(cell::Cell& c) {
+  auto points = std::make_shared<ToolPoints>();
+  points->leader.reserve(20000);
+  points->follower.reserve(20000);
+  c.set_cycle_observer([&c, points](std::uint32_t) {
+    ToolPoints& r = *points;
+    const rccl::TrajectoryGenerator& gp = c.robot("puma").generator();
+    const rccl::TrajectoryGenerator& gm = c.robot("microbo").generator();
+    if (gp.last_setpoint().size() == 6 && gp.last_setpoint_time_s() != r.leader_t &&
+        r.leader.size() < r.leader.capacity()) {
+      r.leader_t = gp.last_setpoint_time_s();
+      r.leader.push_back({r.leader_t, tool_point(c, "puma", gp.last_setpoint())});
+    }
+    if (gm.last_setpoint().size() == 6 && gm.last_setpoint_time_s() != r.follower_t &&
+        r.follower.size() < r.follower.capacity()) {
+      r.follower_t = gm.last_setpoint_time_s();
+      r.follower.push_back({r.follower_t, tool_point(c, "microbo", gm.last_setpoint())});
+    }
+  });
+  return points;
+}
 
 TEST(CellRuntime, BuildsEveryRobotOfTheCellFile) {
   const auto c = cell::Cell::load(kCvarl);
@@ -120,29 +164,8 @@ TEST(CellRuntime, BothRobotsMoveAtOnceInJointAndCartesianMode) {
 
 TEST(CellRuntime, TheMicroboFollowsAFrameThePumaMoves) {
   const auto c = cell::Cell::load(kCvarl);
-  // Every new setpoint of each robot (the control task's), kept for the comparison after.
-  struct Sample {
-    double t_s;
-    math::Vec3 p;
-  };
-  std::vector<Sample> leader, follower;
-  leader.reserve(20000);
-  follower.reserve(20000);
-  double leader_t = -1.0, follower_t = -1.0;
-  c->set_cycle_observer([&](std::uint32_t) {
-    const rccl::TrajectoryGenerator& gp = c->robot("puma").generator();
-    const rccl::TrajectoryGenerator& gm = c->robot("microbo").generator();
-    if (gp.last_setpoint().size() == 6 && gp.last_setpoint_time_s() != leader_t &&
-        leader.size() < leader.capacity()) {
-      leader_t = gp.last_setpoint_time_s();
-      leader.push_back({leader_t, tool_point(*c, "puma", gp.last_setpoint())});
-    }
-    if (gm.last_setpoint().size() == 6 && gm.last_setpoint_time_s() != follower_t &&
-        follower.size() < follower.capacity()) {
-      follower_t = gm.last_setpoint_time_s();
-      follower.push_back({follower_t, tool_point(*c, "microbo", gm.last_setpoint())});
-    }
-  });
+  const std::shared_ptr<ToolPoints> points = record_tool_points(*c);
+  const std::vector<ToolPoints::Sample>& follower = points->follower;
   c->start();
   rccl::Manipulator& puma = c->robot("puma");
   rccl::Manipulator& microbo = c->robot("microbo");
@@ -190,14 +213,8 @@ TEST(CellRuntime, TheMicroboFollowsAFrameThePumaMoves) {
   std::size_t compared = 0;
   for (std::size_t i = from; i < follower.size(); ++i) {
     const double t = follower[i].t_s;
-    if (t <= following_from_s) continue;
-    const auto it = std::lower_bound(leader.begin(), leader.end(), t,
-                                     [](const Sample& s, double x) { return s.t_s < x; });
-    if (it == leader.begin() || it == leader.end()) continue;
-    const Sample& b = *it;
-    const Sample& a = *(it - 1);
-    const double u = (t - a.t_s) / (b.t_s - a.t_s);
-    const math::Vec3 lp = a.p + (b.p - a.p) * u;
+    math::Vec3 lp;
+    if (t <= following_from_s || !points->leader_at(t, lp)) continue;
     worst_m = std::max(worst_m, (follower[i].p - (lp + math::Vec3{0.15, 0.0, 0.0})).norm());
     travel_m = std::max(travel_m, std::abs(follower[i].p.y));
     ++compared;
@@ -214,28 +231,8 @@ TEST(CellRuntime, TheMicroboFollowsAFrameThePumaMoves) {
 // planned, and swept along its way).
 TEST(CellRuntime, ALineOntoAFrameThePumaMovesIsStraightRelativeToIt) {
   const auto c = cell::Cell::load(kCvarl);
-  struct Sample {
-    double t_s;
-    math::Vec3 p;
-  };
-  std::vector<Sample> leader, follower;
-  leader.reserve(20000);
-  follower.reserve(5000);
-  double leader_t = -1.0, follower_t = -1.0;
-  c->set_cycle_observer([&](std::uint32_t) {
-    const rccl::TrajectoryGenerator& gp = c->robot("puma").generator();
-    const rccl::TrajectoryGenerator& gm = c->robot("microbo").generator();
-    if (gp.last_setpoint().size() == 6 && gp.last_setpoint_time_s() != leader_t &&
-        leader.size() < leader.capacity()) {
-      leader_t = gp.last_setpoint_time_s();
-      leader.push_back({leader_t, tool_point(*c, "puma", gp.last_setpoint())});
-    }
-    if (gm.last_setpoint().size() == 6 && gm.last_setpoint_time_s() != follower_t &&
-        follower.size() < follower.capacity()) {
-      follower_t = gm.last_setpoint_time_s();
-      follower.push_back({follower_t, tool_point(*c, "microbo", gm.last_setpoint())});
-    }
-  });
+  const std::shared_ptr<ToolPoints> points = record_tool_points(*c);
+  const std::vector<ToolPoints::Sample>& follower = points->follower;
   c->start();
   rccl::Manipulator& puma = c->robot("puma");
   rccl::Manipulator& microbo = c->robot("microbo");
@@ -288,14 +285,10 @@ TEST(CellRuntime, ALineOntoAFrameThePumaMovesIsStraightRelativeToIt) {
   std::size_t compared = 0;
   math::Vec3 previous;
   double previous_t = -1.0;
-  for (const Sample& f : follower) {
-    if (f.t_s < down_from_s || f.t_s > down_to_s) continue;
-    const auto it = std::lower_bound(leader.begin(), leader.end(), f.t_s,
-                                     [](const Sample& s, double x) { return s.t_s < x; });
-    if (it == leader.begin() || it == leader.end()) continue;
-    const double u = (f.t_s - (it - 1)->t_s) / (it->t_s - (it - 1)->t_s);
-    const math::Vec3 frame = (it - 1)->p + (it->p - (it - 1)->p) * u + math::Vec3{0.15, 0.0, 0.0};
-    const math::Vec3 rel = f.p - frame;
+  for (const ToolPoints::Sample& f : follower) {
+    math::Vec3 leader_p;
+    if (f.t_s < down_from_s || f.t_s > down_to_s || !points->leader_at(f.t_s, leader_p)) continue;
+    const math::Vec3 rel = f.p - (leader_p + math::Vec3{0.15, 0.0, 0.0});
     off_line_m = std::max(off_line_m, std::hypot(rel.x, rel.y));
     lowest_m = std::min(lowest_m, rel.z);
     if (previous_t >= 0.0) {

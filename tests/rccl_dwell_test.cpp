@@ -18,15 +18,6 @@ namespace {
 using namespace rccx;
 using test::GeneratorRun;
 
-std::uint64_t dwell(GeneratorRun& run, double s) {
-  rccl::MotionRequest r;
-  r.kind = rccl::RequestKind::dwell;
-  r.id = run.next_id++;
-  r.dwell_s = s;
-  if (!run.generator.submit(r)) throw std::runtime_error("queue full");
-  return r.id;
-}
-
 /// The longest time no joint's setpoint changes between samples, s (a still arm: its
 /// setpoints repeat exactly).
 double longest_still_s(const GeneratorRun& run) {
@@ -81,7 +72,7 @@ TEST_P(Dwell, TheArmIsStillForTheTimeAStopAsks) {
     s.translation_m_per_s = 0.1;
     s.transition_time_s = 0.2;  // the times asked step around it
     run.move(a, s);
-    dwell(run, ms / 1000.0);
+    run.dwell(ms / 1000.0);
     const std::uint64_t last = run.move(b, s);
     ASSERT_TRUE(run.run_until_ended(last, 30.0));
     ASSERT_EQ(run.find_event(rccl::EventKind::failed), nullptr);

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -31,6 +32,16 @@ struct GeneratorRun {
     r.position = p.get();
     r.settings = s;
     p->pending_ends.fetch_add(1);
+    if (!generator.submit(r)) throw std::runtime_error("queue full");
+    return r.id;
+  }
+
+  /// Queues a dwell (RCCL's stop) of `s` seconds; returns its id.
+  std::uint64_t dwell(double s) {
+    rccl::MotionRequest r;
+    r.kind = rccl::RequestKind::dwell;
+    r.id = next_id++;
+    r.dwell_s = s;
     if (!generator.submit(r)) throw std::runtime_error("queue full");
     return r.id;
   }

@@ -37,16 +37,6 @@ rccl::MotionSettings cartesian(double v_m_per_s) {
   return s;
 }
 
-/// Queues RCCL's stop(ms): the arm stays on the last position (tracking it) for `s` seconds.
-std::uint64_t dwell(GeneratorRun& run, double s) {
-  rccl::MotionRequest r;
-  r.kind = rccl::RequestKind::dwell;
-  r.id = run.next_id++;
-  r.dwell_s = s;
-  if (!run.generator.submit(r)) throw std::runtime_error("queue full");
-  return r.id;
-}
-
 void PrintTo(const BeltCase& c, std::ostream* os) {
   *os << c.robot << " at " << c.period_s * 1e3 << " ms, belt " << c.belt_m_per_s * 1e3 << " mm/s";
 }
@@ -75,11 +65,11 @@ TEST_P(MovingGoal, DescentAndLiftAreStraightRelativeToThePartAtTheSetSpeed) {
   const auto on = rccl::Position::make("ON", {t6}, {belt, part}, t6);
 
   run.move(above, cartesian(0.2));
-  dwell(run, 0.3);
+  run.dwell(0.3);
   const std::uint64_t down = run.move(on, cartesian(kSpeed_m_per_s));
-  dwell(run, 0.3);
+  run.dwell(0.3);
   const std::uint64_t lift = run.move(above, cartesian(kSpeed_m_per_s));
-  const std::uint64_t last = dwell(run, 0.3);
+  const std::uint64_t last = run.dwell(0.3);
   ASSERT_TRUE(run.run_until_ended(last, 30.0));
   ASSERT_EQ(run.find_event(rccl::EventKind::failed), nullptr)
       << run.find_event(rccl::EventKind::failed)->message();
