@@ -406,8 +406,9 @@ int setconf(const char* configuration);
 int move(POS_PTR p);
 
 /**
- * stop: stay where the motion queued before ends, for `ms` milliseconds (> 0), then go on
- * with the next. Queued like move(). Returns 0 or an error code as move().
+ * stop: the motion queued before comes to rest, the arm stays there (tracking a moving goal)
+ * for `ms` milliseconds (>= 0; rounded up to whole samples, at least 3: docs/RCCL.md), then the
+ * next starts from rest. Queued like move(). Returns 0 or an error code as move().
  */
 int stop(double ms);
 

@@ -367,8 +367,8 @@ int move(POS_PTR p) {
 int stop(double ms) {
   const int code = guarded("stop", Say::print, RTC_E_ARGUMENT, [&] {
     State& s = state();
-    if (!(ms > 0.0) || !std::isfinite(ms)) {
-      return fail(RTC_E_ARGUMENT, fmt::format("stop({}): the time is > 0 ms", ms), Say::print);
+    if (!(ms >= 0.0) || !std::isfinite(ms)) {
+      return fail(RTC_E_ARGUMENT, fmt::format("stop({}): the time is >= 0 ms", ms), Say::print);
     }
     if (const int c = check_can_move(s, fmt::format("stop({})", ms)); c != RTC_OK) return c;
     ArmSession& a = *s.arm_session;

@@ -377,15 +377,20 @@ TEST_F(CompatManual, StopHoldsTheArmForItsTime) {
   waitfor(p1->end);
   wait_samples(5);
   const long t1 = rtime;
-  // The arm stays at P1 for the dwell, less the half of the transition to P2 that precedes
-  // the dwell's end (settime's 200 ms, centred on the via point).
-  while (rtime - t1 < 1000 - 5 * 28 - 100 - 28) {
+  // The arm stays at P1 for the whole dwell, from the sample it came to rest on (p1's end):
+  // a stop is not blended with the motions either side (docs/RCCL.md, "stop(ms)").
+  while (rtime - t1 < 1000 - 5 * 28 - 28) {
     EXPECT_LT(position_error_mm(value_mm(*b)), 2.0) << "at " << rtime - t1 << " ms";
     ASSERT_EQ(rccl_wait_sample(), RTC_OK);
   }
   waitfor(p2->end);
   EXPECT_GT(rtime - t1, 1000);
-  EXPECT_EQ(rccl_close(0), RTC_OK) << message();
+  // stop(0): come to rest and go on; a negative or not-a-number time is refused.
+  EXPECT_EQ(stop(0.0), RTC_OK) << message();
+  EXPECT_EQ(stop(-1.0), RTC_E_ARGUMENT);
+  EXPECT_EQ(stop(std::nan("")), RTC_E_ARGUMENT);
+  waitfor(completed);
+  EXPECT_EQ(rccl_close(0), RTC_E_ARGUMENT);  // the program's refused calls are its error status
 }
 
 /// The measured joints of the last row of an RCCX_LOG file (rad).
