@@ -103,6 +103,55 @@ TEST_P(MovingGoal, DescentAndLiftAreStraightRelativeToThePartAtTheSetSpeed) {
   EXPECT_LE(fastest_m_per_s, kSpeed_m_per_s * 1.01);
 }
 
+// The same motions joined without stops: the corner from the approach into the descent is cut
+// by its transition (as any corner), the turn from the descent into the lift runs back along
+// the same line. Below the transition's reach (the lower 60 % of the way) both are on the line.
+TEST_P(MovingGoal, JoinedWithoutStopsTheDescentAndTheLiftStayOnTheLine) {
+  const BeltCase c = GetParam();
+  GeneratorRun run(c.robot, c.period_s);
+  const math::Transform home = run.kinematics->forward(run.model.ready());
+  constexpr double kHeight_m = 0.05, kSpeed_m_per_s = 0.05;
+  const double y0 = -c.belt_m_per_s * 1.5;
+  const math::Transform part_at_0{home.R, home.p + math::Vec3{0.0, y0, -0.04}};
+  auto belt = rccl::functional("CONV", [v = c.belt_m_per_s](const rccl::SampleContext& ctx) {
+    return math::Transform::translation(0.0, v * ctx.t_s, 0.0);
+  });
+  const auto part = rccl::constant("PART", part_at_0);
+  const auto up = rccl::constant("UP", math::Transform::translation(0.0, 0.0, kHeight_m));
+  const auto t6 = rccl::t6();
+  const auto above = rccl::Position::make("ABOVE", {t6}, {belt, up, part}, t6);
+  const auto on = rccl::Position::make("ON", {t6}, {belt, part}, t6);
+  run.move(above, cartesian(0.2));
+  const std::uint64_t down = run.move(on, cartesian(kSpeed_m_per_s));
+  const std::uint64_t lift = run.move(above, cartesian(kSpeed_m_per_s));
+  ASSERT_TRUE(run.run_until_ended(lift, 30.0));
+  ASSERT_EQ(run.find_event(rccl::EventKind::failed), nullptr)
+      << run.find_event(rccl::EventKind::failed)->message();
+  double off_line_m = 0.0, fastest_m_per_s = 0.0;
+  std::size_t compared = 0;
+  math::Vec3 previous;
+  bool have_previous = false;
+  for (std::size_t k = 0; k < run.qs.size(); ++k) {
+    const math::Vec3 part_now = part_at_0.p + math::Vec3{0.0, c.belt_m_per_s * run.t[k], 0.0};
+    const math::Vec3 rel = run.kinematics->forward(run.qs[k]).p - part_now;
+    const bool on_line =
+        (run.segment[k] == down || run.segment[k] == lift) && rel.z < 0.6 * kHeight_m;
+    if (on_line) {
+      off_line_m = std::max(off_line_m, std::hypot(rel.x, rel.y));
+      ++compared;
+      if (have_previous)
+        fastest_m_per_s = std::max(fastest_m_per_s, (rel - previous).norm() / run.period);
+    }
+    previous = rel;
+    have_previous = on_line;
+  }
+  std::printf("%s at %.0f mm/s, joined: %.4f mm off the line (%zu samples), fastest %.2f mm/s\n",
+              c.robot, c.belt_m_per_s * 1e3, off_line_m * 1e3, compared, fastest_m_per_s * 1e3);
+  EXPECT_GT(compared, 20U);
+  EXPECT_LT(off_line_m, 0.5e-3);
+  EXPECT_LE(fastest_m_per_s, kSpeed_m_per_s * 1.01);
+}
+
 // A joint motion onto a moving goal ends on fixed joints: those of the goal where it will be
 // when the motion's line ends, so that a Cartesian line from there (the descent) starts above
 // the part and runs straight down onto it.
