@@ -41,6 +41,32 @@ void PrintTo(const BeltCase& c, std::ostream* os) {
   *os << c.robot << " at " << c.period_s * 1e3 << " ms, belt " << c.belt_m_per_s * 1e3 << " mm/s";
 }
 
+/// A part on a belt along y, 40 mm below the ready pose's T6, `upstream_s` of belt travel
+/// upstream of it at t = 0; ABOVE is `height_m` over it (world z), ON on it.
+struct Belt {
+  Belt(const GeneratorRun& run, double speed_m_per_s, double upstream_s, double height_m)
+      : speed(speed_m_per_s) {
+    const math::Transform home = run.kinematics->forward(run.model.ready());
+    part_at_0 = {home.R, home.p + math::Vec3{0.0, -speed * upstream_s, -0.04}};
+    const auto conv = rccl::functional("CONV", [v = speed](const rccl::SampleContext& ctx) {
+      return math::Transform::translation(0.0, v * ctx.t_s, 0.0);
+    });
+    const auto part = rccl::constant("PART", part_at_0);
+    const auto up = rccl::constant("UP", math::Transform::translation(0.0, 0.0, height_m));
+    const auto t6 = rccl::t6();
+    above = rccl::Position::make("ABOVE", {t6}, {conv, up, part}, t6);
+    on = rccl::Position::make("ON", {t6}, {conv, part}, t6);
+  }
+  /// T6 (no tool transform) of setpoint k from the part (which only translates), m.
+  [[nodiscard]] math::Vec3 relative(const GeneratorRun& run, std::size_t k) const {
+    const math::Vec3 part_now = part_at_0.p + math::Vec3{0.0, speed * run.t[k], 0.0};
+    return run.kinematics->forward(run.qs[k]).p - part_now;
+  }
+  double speed;
+  math::Transform part_at_0;
+  rccl::PositionPtr above, on;
+};
+
 class MovingGoal : public ::testing::TestWithParam<BeltCase> {};
 
 // Above the part, down onto it, up off it, each joined to a stop on the part (the arm tracks it
@@ -49,26 +75,15 @@ class MovingGoal : public ::testing::TestWithParam<BeltCase> {};
 TEST_P(MovingGoal, DescentAndLiftAreStraightRelativeToThePartAtTheSetSpeed) {
   const BeltCase c = GetParam();
   GeneratorRun run(c.robot, c.period_s);
-  const math::Transform home = run.kinematics->forward(run.model.ready());
   constexpr double kHeight_m = 0.05;       // above the part
   constexpr double kSpeed_m_per_s = 0.05;  // down and up, relative to the part
-  // The belt carries the part along y; it starts upstream so that it passes under the arm.
-  const double y0 = -c.belt_m_per_s * 2.5;  // the program takes about 5 s
-  const math::Transform part_at_0{home.R, home.p + math::Vec3{0.0, y0, -0.04}};
-  auto belt = rccl::functional("CONV", [v = c.belt_m_per_s](const rccl::SampleContext& ctx) {
-    return math::Transform::translation(0.0, v * ctx.t_s, 0.0);
-  });
-  const auto part = rccl::constant("PART", part_at_0);
-  const auto up = rccl::constant("UP", math::Transform::translation(0.0, 0.0, kHeight_m));  // world
-  const auto t6 = rccl::t6();
-  const auto above = rccl::Position::make("ABOVE", {t6}, {belt, up, part}, t6);
-  const auto on = rccl::Position::make("ON", {t6}, {belt, part}, t6);
+  const Belt belt(run, c.belt_m_per_s, 2.5, kHeight_m);
 
-  run.move(above, cartesian(0.2));
+  run.move(belt.above, cartesian(0.2));
   run.dwell(0.3);
-  const std::uint64_t down = run.move(on, cartesian(kSpeed_m_per_s));
+  const std::uint64_t down = run.move(belt.on, cartesian(kSpeed_m_per_s));
   run.dwell(0.3);
-  const std::uint64_t lift = run.move(above, cartesian(kSpeed_m_per_s));
+  const std::uint64_t lift = run.move(belt.above, cartesian(kSpeed_m_per_s));
   const std::uint64_t last = run.dwell(0.3);
   ASSERT_TRUE(run.run_until_ended(last, 30.0));
   ASSERT_EQ(run.find_event(rccl::EventKind::failed), nullptr)
@@ -81,10 +96,7 @@ TEST_P(MovingGoal, DescentAndLiftAreStraightRelativeToThePartAtTheSetSpeed) {
   bool have_previous = false;
   for (std::size_t k = 0; k < run.qs.size(); ++k) {
     if (run.t[k] < from_s) continue;
-    // The tool (T6, no tool transform) from the part (which only translates), on the setpoint
-    // of sample k.
-    const math::Vec3 part_now = part_at_0.p + math::Vec3{0.0, c.belt_m_per_s * run.t[k], 0.0};
-    const math::Vec3 rel = run.kinematics->forward(run.qs[k]).p - part_now;
+    const math::Vec3 rel = belt.relative(run, k);
     off_line_m = std::max(off_line_m, std::hypot(rel.x, rel.y));
     lowest_m = std::min(lowest_m, rel.z);
     if (have_previous) {
@@ -109,21 +121,11 @@ TEST_P(MovingGoal, DescentAndLiftAreStraightRelativeToThePartAtTheSetSpeed) {
 TEST_P(MovingGoal, JoinedWithoutStopsTheDescentAndTheLiftStayOnTheLine) {
   const BeltCase c = GetParam();
   GeneratorRun run(c.robot, c.period_s);
-  const math::Transform home = run.kinematics->forward(run.model.ready());
   constexpr double kHeight_m = 0.05, kSpeed_m_per_s = 0.05;
-  const double y0 = -c.belt_m_per_s * 1.5;
-  const math::Transform part_at_0{home.R, home.p + math::Vec3{0.0, y0, -0.04}};
-  auto belt = rccl::functional("CONV", [v = c.belt_m_per_s](const rccl::SampleContext& ctx) {
-    return math::Transform::translation(0.0, v * ctx.t_s, 0.0);
-  });
-  const auto part = rccl::constant("PART", part_at_0);
-  const auto up = rccl::constant("UP", math::Transform::translation(0.0, 0.0, kHeight_m));
-  const auto t6 = rccl::t6();
-  const auto above = rccl::Position::make("ABOVE", {t6}, {belt, up, part}, t6);
-  const auto on = rccl::Position::make("ON", {t6}, {belt, part}, t6);
-  run.move(above, cartesian(0.2));
-  const std::uint64_t down = run.move(on, cartesian(kSpeed_m_per_s));
-  const std::uint64_t lift = run.move(above, cartesian(kSpeed_m_per_s));
+  const Belt belt(run, c.belt_m_per_s, 1.5, kHeight_m);
+  run.move(belt.above, cartesian(0.2));
+  const std::uint64_t down = run.move(belt.on, cartesian(kSpeed_m_per_s));
+  const std::uint64_t lift = run.move(belt.above, cartesian(kSpeed_m_per_s));
   ASSERT_TRUE(run.run_until_ended(lift, 30.0));
   ASSERT_EQ(run.find_event(rccl::EventKind::failed), nullptr)
       << run.find_event(rccl::EventKind::failed)->message();
@@ -132,8 +134,7 @@ TEST_P(MovingGoal, JoinedWithoutStopsTheDescentAndTheLiftStayOnTheLine) {
   math::Vec3 previous;
   bool have_previous = false;
   for (std::size_t k = 0; k < run.qs.size(); ++k) {
-    const math::Vec3 part_now = part_at_0.p + math::Vec3{0.0, c.belt_m_per_s * run.t[k], 0.0};
-    const math::Vec3 rel = run.kinematics->forward(run.qs[k]).p - part_now;
+    const math::Vec3 rel = belt.relative(run, k);
     const bool on_line =
         (run.segment[k] == down || run.segment[k] == lift) && rel.z < 0.6 * kHeight_m;
     if (on_line) {
@@ -158,26 +159,16 @@ TEST_P(MovingGoal, JoinedWithoutStopsTheDescentAndTheLiftStayOnTheLine) {
 TEST_P(MovingGoal, AJointMotionEndsWhereTheGoalWillBeAndTheDescentFromThereIsStraight) {
   const BeltCase c = GetParam();
   GeneratorRun run(c.robot, c.period_s);
-  const math::Transform home = run.kinematics->forward(run.model.ready());
   constexpr double kHeight_m = 0.05, kSpeed_m_per_s = 0.05;
-  const double y0 = -c.belt_m_per_s * 1.5;
-  const math::Transform part_at_0{home.R, home.p + math::Vec3{0.0, y0, -0.04}};
-  auto belt = rccl::functional("CONV", [v = c.belt_m_per_s](const rccl::SampleContext& ctx) {
-    return math::Transform::translation(0.0, v * ctx.t_s, 0.0);
-  });
-  const auto part = rccl::constant("PART", part_at_0);
-  const auto up = rccl::constant("UP", math::Transform::translation(0.0, 0.0, kHeight_m));
-  const auto t6 = rccl::t6();
-  const auto above = rccl::Position::make("ABOVE", {t6}, {belt, up, part}, t6);
-  const auto on = rccl::Position::make("ON", {t6}, {belt, part}, t6);
+  const Belt belt(run, c.belt_m_per_s, 1.5, kHeight_m);
 
   rccl::MotionSettings joint;
   joint.mode = rccl::Mode::joint;
   // Slow, so that it ends at a moderate speed: the corner the transition into the descent
   // cuts (it blends the joint line, continued past its end, with the descent) stays small.
   joint.segment_time_s = 1.5;
-  run.move(above, joint);
-  const std::uint64_t down = run.move(on, cartesian(kSpeed_m_per_s));
+  run.move(belt.above, joint);
+  const std::uint64_t down = run.move(belt.on, cartesian(kSpeed_m_per_s));
   ASSERT_TRUE(run.run_until_ended(down, 30.0));
   ASSERT_EQ(run.find_event(rccl::EventKind::failed), nullptr)
       << run.find_event(rccl::EventKind::failed)->message();
@@ -186,8 +177,7 @@ TEST_P(MovingGoal, AJointMotionEndsWhereTheGoalWillBeAndTheDescentFromThereIsStr
   double off_line_m = 0.0;
   std::size_t compared = 0;
   for (std::size_t k = 0; k < run.qs.size(); ++k) {
-    const math::Vec3 part_now = part_at_0.p + math::Vec3{0.0, c.belt_m_per_s * run.t[k], 0.0};
-    const math::Vec3 rel = run.kinematics->forward(run.qs[k]).p - part_now;
+    const math::Vec3 rel = belt.relative(run, k);
     if (run.segment[k] != down || rel.z > 0.5 * kHeight_m) continue;
     off_line_m = std::max(off_line_m, std::hypot(rel.x, rel.y));
     ++compared;

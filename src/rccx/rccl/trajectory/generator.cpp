@@ -115,13 +115,13 @@ void TrajectoryGenerator::join_or_end(const SampleContext& ctx) {
   if (!loop_.has_next && may_join && t < te - cur.stop_tau - eps) {
     if (build(*w, ctx, te)) {
       queue_.join();
-      loop_.next_tau = planner_.transition_tau(
-          cur, loop_.next, trajectory::blend_between(cur, &loop_.next), te, ctx);
-      // Planning may have slowed it: a joint line onto a moving goal aims anew at its end.
-      for (int round = 0; round < 2 && builder_.aim_at_end(loop_.next, ctx); ++round) {
+      const auto plan = [&] {
         loop_.next_tau = planner_.transition_tau(
             cur, loop_.next, trajectory::blend_between(cur, &loop_.next), te, ctx);
-      }
+      };
+      plan();
+      // Planning may have slowed it: a joint line onto a moving goal aims anew at its end.
+      for (int round = 0; round < 2 && builder_.aim_at_end(loop_.next, ctx); ++round) plan();
       // Decided late: the window must not have begun already.
       loop_.next_tau = std::min(loop_.next_tau, te - t);
     }
