@@ -15,6 +15,7 @@
 #include "rccx/io/file.hpp"
 #include "rccx/io/parse.hpp"
 #include "rccx/kinematics/kinematics.hpp"
+#include "rccx/kinematics/urdf.hpp"
 #include "rccx/rtc/session.hpp"
 
 namespace rccx::tools {
@@ -79,15 +80,23 @@ inline CLI::Option* add_period_option(CLI::App& cmd, Duration& d, const std::str
   return add_duration_option(cmd, "--period", d, rtc::kMinPeriod, rtc::kMaxPeriod, help);
 }
 
-/// --robot / --robot-file.
+/// --robot / --robot-file / --urdf (with --base-link, --tip-link).
 struct RobotChoice {
   std::string name;
   std::string file;
+  std::string urdf;
+  kin::UrdfOptions urdf_links;
 
   explicit RobotChoice(std::string default_name) : name(std::move(default_name)) {}
 
   [[nodiscard]] kin::RobotModel model() const {
     try {
+      if (!urdf.empty()) return kin::load_urdf(urdf, urdf_links);
+      if (!urdf_links.base_link.empty() || !urdf_links.tip_link.empty()) {
+        throw BadArgument{
+            "--base-link and --tip-link choose the chain of a --urdf robot: give "
+            "--urdf FILE"};
+      }
       return file.empty() ? kin::builtin_robot(name) : kin::load_robot_file(file);
     } catch (const kin::RobotFileError& e) {
       throw BadArgument{e.what()};
@@ -111,6 +120,16 @@ inline void add_robot_options(CLI::App& cmd, RobotChoice& robot) {
   cmd.add_option("--robot-file", robot.file,
                  "Robot description file (JSON, see robots/README.md); overrides --robot")
       ->check(CLI::ExistingFile);
+  cmd.add_option("--urdf", robot.urdf,
+                 "A robot from a URDF file (robots/ur5e.urdf, robots/panda.urdf; a xacro file "
+                 "needs `xacro` first); overrides --robot and --robot-file")
+      ->check(CLI::ExistingFile)
+      ->excludes("--robot-file");
+  cmd.add_option("--base-link", robot.urdf_links.base_link,
+                 "--urdf: the link whose frame is the base (default: the tree's root)");
+  cmd.add_option("--tip-link", robot.urdf_links.tip_link,
+                 "--urdf: the link whose frame is T6 (default: the only leaf; needed when the "
+                 "tree branches)");
 }
 
 /// The position database file: `given`, else $RCCX_DB, else ./rccx.db (one file per cell).

@@ -21,6 +21,9 @@ struct DhSolverSettings {
   double orientation_tolerance_rad = 1e-12;
   double damping = 1e-4;           ///< lambda of (J Jt + lambda^2 I)
   double max_step_rad_or_m = 0.5;  ///< largest joint change per iteration
+  /// Seeds spread over the joint ranges tried after the first seed fails (each up to
+  /// max_iterations): an unreachable pose costs (1 + restarts) solves before it is refused.
+  int restarts = 8;
 };
 
 class DhKinematics final : public Kinematics {
@@ -28,11 +31,14 @@ class DhKinematics final : public Kinematics {
   explicit DhKinematics(RobotModel model, DhSolverSettings settings = {});
 
   [[nodiscard]] math::Transform forward(const JointVector& q) const noexcept override;
-  /// Iterates from options.near (or the ready pose); options.configuration is not used.
+  /// Iterates from options.near (or the ready pose), then from settings.restarts seeds spread
+  /// over the joint ranges; options.configuration is not used.
   [[nodiscard]] IkResult inverse(const math::Transform& pose,
                                  const IkOptions& options = {}) const noexcept override;
 
  private:
+  /// Damped least squares from q (updated in place) towards pose.
+  IkStatus iterate(const math::Transform& pose, JointVector& q) const noexcept;
   DhSolverSettings settings_;
 };
 

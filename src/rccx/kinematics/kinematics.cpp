@@ -83,6 +83,17 @@ Kinematics::Kinematics(RobotModel model) : model_(std::move(model)) {
     // The widened range, so that a value within it never has a second turn within it too.
     limits_[i] = {j.lower, j.upper, lo, hi, revolute, revolute && hi - lo >= 2.0 * math::kPi};
   }
+  general_ = model_.geometry == Geometry::chain;
+  for (std::size_t i = 0; general_ && i < model_.dof(); ++i) {
+    const Joint& j = model_.joints[i];
+    Step& st = steps_[i];
+    st.origin = j.chain.origin;
+    st.axis = j.chain.axis.normalized();
+    st.after = j.chain.after;
+    st.after_identity = j.chain.after.rows() == math::Transform{}.rows();
+    st.prismatic = j.type == JointType::prismatic;
+    st.principal = principal_axis(st.axis);
+  }
   ready_ = model_.ready();
 }
 
@@ -245,6 +256,27 @@ math::Transform Kinematics::chain_forward(const JointVector& q,
                                           math::Transform* frames) const noexcept {
   // All the joint angles' sines and cosines first, four at a time.
   double theta[kMaxJoints] = {}, st[kMaxJoints], ct[kMaxJoints];
+  if (general_) {
+    for (std::size_t i = 0; i < dof(); ++i) theta[i] = steps_[i].prismatic ? 0.0 : q[i];
+    if (dof() > 4) {
+      math::sincos8(theta, st, ct);
+    } else {
+      math::sincos4(theta, st, ct);
+    }
+    math::Transform T;
+    for (std::size_t i = 0; i < dof(); ++i) {
+      const Step& s = steps_[i];
+      T = T * s.origin;
+      if (s.prismatic) {
+        T.p += T.R * (s.axis * q[i]);
+      } else {
+        rotate_about(T.R, s.axis, s.principal, ct[i], st[i]);
+      }
+      if (!s.after_identity) T = T * s.after;
+      if (frames != nullptr) frames[i] = T;
+    }
+    return T;
+  }
   for (std::size_t i = 0; i < dof(); ++i) {
     theta[i] = links_[i].theta + (links_[i].prismatic ? 0.0 : q[i]);
   }
@@ -272,6 +304,17 @@ Jacobian Kinematics::jacobian(const JointVector& q) const noexcept {
 Jacobian Kinematics::jacobian_from_frames(const math::Transform* frames) const noexcept {
   const math::Vec3& tip = frames[dof() - 1].p;
   Jacobian J(6, static_cast<Eigen::Index>(dof()));
+  if (general_) {
+    for (std::size_t i = 0; i < dof(); ++i) {
+      // Joint i+1 moves about / along its axis in the frame (link i) * origin.
+      const math::Transform G = i == 0 ? steps_[i].origin : frames[i - 1] * steps_[i].origin;
+      const math::Vec3 z = G.R * steps_[i].axis;
+      const math::Vec3 v = steps_[i].prismatic ? z : math::cross(z, tip - G.p);
+      const math::Vec3 w = steps_[i].prismatic ? math::Vec3{} : z;
+      J.col(static_cast<Eigen::Index>(i)) << v.x, v.y, v.z, w.x, w.y, w.z;
+    }
+    return J;
+  }
   for (std::size_t i = 0; i < dof(); ++i) {
     // Joint i+1 moves about / along z of frame i (the base frame for the first joint).
     const math::Vec3 z = i == 0 ? math::Vec3{0, 0, 1} : frames[i - 1].R.a;

@@ -110,7 +110,7 @@ class Kinematics {
   [[nodiscard]] virtual IkSolutions inverse_all(const math::Transform& pose,
                                                 const IkOptions& options = {}) const noexcept;
 
-  /// The geometric Jacobian at q, from the DH chain.
+  /// The geometric Jacobian at q, from the chain (DH or general).
   [[nodiscard]] virtual Jacobian jacobian(const JointVector& q) const noexcept;
 
   /// Names of the arm configurations ("lun", "rdf" ... for the PUMA); empty when the solver
@@ -140,8 +140,8 @@ class Kinematics {
   /// The model's ready pose, built once.
   const JointVector& ready_pose() const noexcept { return ready_; }
 
-  /// T6 by multiplying the DH chain's A matrices (thesis eq. 3.11); frames[i], when given,
-  /// receives A1 ... A(i+1), the frame of link i+1.
+  /// T6 by multiplying the DH chain's A matrices (thesis eq. 3.11), or a general chain's
+  /// steps; frames[i], when given, receives the frame of link i+1 (A1 ... A(i+1)).
   math::Transform chain_forward(const JointVector& q,
                                 math::Transform* frames = nullptr) const noexcept;
 
@@ -154,6 +154,20 @@ class Kinematics {
     bool prismatic;
   };
   std::array<Link, kMaxJoints> links_{};
+
+  /// Cached per-joint constants of a general chain (Geometry::chain): see ChainStep.
+  struct Step {
+    math::Transform origin;
+    math::Vec3 axis;
+    math::Transform after;
+    /// 0 any axis; 1, 2, 3: +x, +y, +z; -1, -2, -3: the negative ones (a cheaper rotation).
+    int principal = 0;
+    bool after_identity = true;
+    bool prismatic = false;
+  };
+  std::array<Step, kMaxJoints> steps_{};
+  /// The model is a general chain: chain_forward and jacobian_from_frames use steps_.
+  bool general_ = false;
 
  private:
   /// Per-joint limit constants for fit_to_limits, which runs on every inverse call.

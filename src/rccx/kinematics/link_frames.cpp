@@ -18,6 +18,17 @@ DhChain::DhChain(const RobotModel& model) noexcept : dof(std::min(model.dof(), k
     if (std::abs(l.cos_alpha) < 1e-15) l.cos_alpha = 0.0;
     if (std::abs(l.sin_alpha) < 1e-15) l.sin_alpha = 0.0;
   }
+  general = model.geometry == Geometry::chain;
+  for (std::size_t i = 0; general && i < dof; ++i) {
+    const Joint& j = model.joints[i];
+    Step& s = steps[i];
+    s.origin = j.chain.origin;
+    s.axis = j.chain.axis.normalized();
+    s.after = j.chain.after;
+    s.principal = principal_axis(s.axis);
+    s.after_identity = j.chain.after.rows() == math::Transform{}.rows();
+    s.prismatic = j.type == JointType::prismatic;
+  }
 }
 
 void link_frames(const DhChain& chain, const JointVector& q, std::span<math::Transform> out,
@@ -25,7 +36,8 @@ void link_frames(const DhChain& chain, const JointVector& q, std::span<math::Tra
   const std::size_t n = std::min(chain.dof, out.size());
   double theta[kMaxJoints] = {}, st[kMaxJoints], ct[kMaxJoints];
   for (std::size_t i = 0; i < n; ++i) {
-    theta[i] = chain.links[i].theta_rad + (chain.links[i].prismatic ? 0.0 : q[i]);
+    theta[i] = chain.general ? (chain.steps[i].prismatic ? 0.0 : q[i])
+                             : chain.links[i].theta_rad + (chain.links[i].prismatic ? 0.0 : q[i]);
   }
   if (n > 4) {
     math::sincos8(theta, st, ct);
@@ -33,6 +45,20 @@ void link_frames(const DhChain& chain, const JointVector& q, std::span<math::Tra
     math::sincos4(theta, st, ct);
   }
   math::Transform T = base;
+  if (chain.general) {  // as Kinematics::chain_forward, from the base
+    for (std::size_t i = 0; i < n; ++i) {
+      const DhChain::Step& s = chain.steps[i];
+      T = T * s.origin;
+      if (s.prismatic) {
+        T.p += T.R * (s.axis * q[i]);
+      } else {
+        rotate_about(T.R, s.axis, s.principal, ct[i], st[i]);
+      }
+      if (!s.after_identity) T = T * s.after;
+      out[i] = T;
+    }
+    return;
+  }
   for (std::size_t i = 0; i < n; ++i) {
     const DhChain::Link& l = chain.links[i];
     const double d = l.d_m + (l.prismatic ? q[i] : 0.0);

@@ -1,4 +1,4 @@
-// Every link frame of a standard DH chain, not only T6: what collision capsules and other
+// Every link frame of a chain (DH or general), not only T6: what collision capsules and other
 // per-link geometry need each sample. Noexcept and allocation-free, like forward().
 //
 //   const kin::DhChain chain(model);                 // once: the chain's constants
@@ -31,6 +31,17 @@ struct DhChain {
   };
   std::array<Link, kMaxJoints> links{};
   std::size_t dof = 0;  ///< at most kMaxJoints: joints past it are ignored
+  /// A general chain's steps (Geometry::chain, a URDF's): used instead of `links` when set.
+  struct Step {
+    math::Transform origin;
+    math::Vec3 axis{0, 0, 1};
+    math::Transform after;
+    int principal = 3;  ///< principal_axis(axis)
+    bool after_identity = true;
+    bool prismatic = false;
+  };
+  std::array<Step, kMaxJoints> steps{};
+  bool general = false;
 
   DhChain() = default;
   explicit DhChain(const RobotModel& model) noexcept;

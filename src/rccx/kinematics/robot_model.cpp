@@ -69,6 +69,10 @@ std::string_view to_string(SolverKind kind) noexcept {
   return "?";
 }
 
+std::string_view to_string(Geometry geometry) noexcept {
+  return geometry == Geometry::dh ? "dh" : "chain";
+}
+
 std::string_view to_string(Plant plant) noexcept {
   switch (plant) {
     case Plant::automatic:

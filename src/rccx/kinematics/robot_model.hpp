@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "rccx/kinematics/joint_vector.hpp"
+#include "rccx/math/transform.hpp"
 
 namespace rccx::kin {
 
@@ -43,10 +44,26 @@ struct JointDynamics {
   std::array<double, 3> link_com_m{};  ///< that link's centre of mass in its own DH frame, m
 };
 
+/// A joint of a general serial chain, as a URDF gives it: the frame of link i is
+/// (link i-1) * origin * Motion(axis, q) * after, where Motion rotates about the unit `axis`
+/// (revolute, rad) or moves along it (prismatic, m). `after` is the identity but on the last
+/// joint, where it carries the fixed joints out to the tip (the flange). Used instead of `dh`
+/// when RobotModel::geometry is Geometry::chain.
+struct ChainStep {
+  math::Transform origin;
+  math::Vec3 axis{0, 0, 1};
+  math::Transform after;
+};
+
 struct Joint {
   std::string name;
   JointType type = JointType::revolute;
   DhParameters dh;
+  ChainStep chain;  ///< Geometry::chain only
+  /// A URDF continuous joint: revolute with no limits (lower / upper are -inf / +inf). The
+  /// generator interpolates it as any revolute joint, and the solvers keep it within a turn of
+  /// the pose they are asked to stay near.
+  bool continuous = false;
   double lower = 0.0;                 ///< lower limit, rad or m
   double upper = 0.0;                 ///< upper limit, rad or m
   double resolution_per_count = 0.0;  ///< encoder resolution, rad or m per count
@@ -64,11 +81,16 @@ enum class SolverKind : std::uint8_t { microbo, puma, dh };
 /// simulated PUMA when every joint has dynamics, else the ideal servo.
 enum class Plant : std::uint8_t { automatic, ideal, servo, mujoco };
 
+/// How a model gives its links: a standard DH table (thesis 3.4, robots/*.json) or a general
+/// chain of origins and axes (a URDF, kin::load_urdf).
+enum class Geometry : std::uint8_t { dh, chain };
+
 struct RobotModel {
   std::string name;    ///< short id used on the command line ("microbo", "puma560")
   std::string title;   ///< human name
   std::string source;  ///< where the numbers come from
   SolverKind solver = SolverKind::dh;
+  Geometry geometry = Geometry::dh;
   std::vector<Joint> joints;
   /// The file's "hardware" object as JSON text (empty when none): what a simulator of this
   /// robot's controller needs (the Microbo's RCU), parsed and checked by rccx::hw.
@@ -106,5 +128,6 @@ RobotModel builtin_robot(std::string_view name);
 std::string_view to_string(JointType type) noexcept;
 std::string_view to_string(SolverKind kind) noexcept;
 std::string_view to_string(Plant plant) noexcept;
+std::string_view to_string(Geometry geometry) noexcept;
 
 }  // namespace rccx::kin

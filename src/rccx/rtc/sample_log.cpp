@@ -56,6 +56,13 @@ std::string kinematics_fingerprint(const kin::RobotModel& model) {
     for (unsigned char c : text) h = (h ^ c) * 1099511628211ULL;
   };
   for (const kin::Joint& j : model.joints) {
+    if (model.geometry == kin::Geometry::chain) {  // a URDF's: origin, axis, after
+      mix(fmt::format("{} {:.17g} {:.17g} {:.17g} {:.17g};", kin::to_string(j.type),
+                      fmt::join(j.chain.origin.rows(), " "), j.chain.axis.x, j.chain.axis.y,
+                      j.chain.axis.z));
+      mix(fmt::format("{:.17g};", fmt::join(j.chain.after.rows(), " ")));
+      continue;
+    }
     mix(fmt::format("{} {:.17g} {:.17g} {:.17g} {:.17g};", kin::to_string(j.type), j.dh.a_m,
                     j.dh.alpha_rad, j.dh.d_m, j.dh.theta_rad));
   }

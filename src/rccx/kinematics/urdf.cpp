@@ -1,0 +1,384 @@
+#include "rccx/kinematics/urdf.hpp"
+
+#include <console_bridge/console.h>
+#include <fmt/format.h>
+
+#include <tinyxml.h>
+#include <urdf_parser/urdf_parser.h>
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <mutex>
+#include <numbers>
+#include <sstream>
+#include <vector>
+
+namespace rccx::kin {
+
+namespace {
+
+/// Limits of what a robot arm's URDF can sensibly say: beyond them a number is a typo or an
+/// attack, and the message says which.
+constexpr double kMaxOffset_m = 100.0;
+constexpr double kMaxMass_kg = 1e5;
+constexpr double kMaxLimit = 1e3;  // rad or m
+
+/// urdfdom reports through console_bridge; its words go into our message, not to stderr.
+class CapturedLog final : public console_bridge::OutputHandler {
+ public:
+  void log(const std::string& text, console_bridge::LogLevel level, const char* /*file*/,
+           int /*line*/) override {
+    if (level >= console_bridge::CONSOLE_BRIDGE_LOG_WARN) lines.push_back(text);
+  }
+  std::vector<std::string> lines;
+};
+
+std::mutex& console_mutex() {
+  static std::mutex m;  // console_bridge's handler is one for the process
+  return m;
+}
+
+math::Transform to_transform(const urdf::Pose& pose) {
+  const urdf::Rotation& r = pose.rotation;
+  const double x = r.x, y = r.y, z = r.z, w = r.w;
+  const double n = std::sqrt(x * x + y * y + z * z + w * w);
+  math::Transform T;
+  if (n > 0.0 && std::isfinite(n)) {
+    const double qx = x / n, qy = y / n, qz = z / n, qw = w / n;
+    T.R.n = {1 - 2 * (qy * qy + qz * qz), 2 * (qx * qy + qz * qw), 2 * (qx * qz - qy * qw)};
+    T.R.o = {2 * (qx * qy - qz * qw), 1 - 2 * (qx * qx + qz * qz), 2 * (qy * qz + qx * qw)};
+    T.R.a = {2 * (qx * qz + qy * qw), 2 * (qy * qz - qx * qw), 1 - 2 * (qx * qx + qy * qy)};
+  } else {
+    T.R.n.x = std::nan("");  // caught by the finiteness check
+  }
+  T.p = {pose.position.x, pose.position.y, pose.position.z};
+  return T;
+}
+
+bool finite(const math::Transform& T) {
+  for (const double v : T.rows()) {
+    if (!std::isfinite(v)) return false;
+  }
+  return true;
+}
+
+class Reader {
+ public:
+  Reader(std::string_view origin, const UrdfOptions& options)
+      : origin_(origin), options_(options) {}
+
+  RobotModel read(std::string_view xml) {
+    if (xml.size() > kMaxUrdfBytes) {
+      fail(
+          fmt::format("{} bytes, more than the {} MB a URDF may have here (an arm's URDF is "
+                      "tens of kB; meshes go in their own files)",
+                      xml.size(), kMaxUrdfBytes >> 20));
+    }
+    if (xml.find("xmlns:xacro") != std::string_view::npos ||
+        xml.find("<xacro:") != std::string_view::npos) {
+      fail("this is a xacro file, not URDF: run `xacro FILE > robot.urdf` first and read that");
+    }
+    check_tree(xml);
+    const urdf::ModelInterfaceSharedPtr model = parse(xml);
+    const auto [chain, base] = chain_links(*model);
+    return build(*model, chain, base);
+  }
+
+ private:
+  [[noreturn]] void fail(const std::string& why) const {
+    throw RobotFileError(fmt::format("{}: {}", origin_, why));
+  }
+
+  /// The links' parents as the joints give them, checked before urdfdom builds its tree: a
+  /// cycle would leak urdfdom's links (they hold each other), and its words for one are about
+  /// roots. A text that is not XML is left to urdfdom's message.
+  void check_tree(std::string_view xml) const {
+    TiXmlDocument doc;
+    doc.Parse(std::string(xml).c_str());
+    const TiXmlElement* robot = doc.Error() ? nullptr : doc.FirstChildElement("robot");
+    if (robot == nullptr) return;
+    std::map<std::string, bool> links;
+    for (const TiXmlElement* l = robot->FirstChildElement("link"); l != nullptr;
+         l = l->NextSiblingElement("link")) {
+      if (const char* name = l->Attribute("name")) links[name] = true;
+    }
+    struct Up {
+      std::string parent, joint;
+    };
+    std::map<std::string, Up> up;  // child link -> its parent link and joint
+    for (const TiXmlElement* j = robot->FirstChildElement("joint"); j != nullptr;
+         j = j->NextSiblingElement("joint")) {
+      const char* name = j->Attribute("name");
+      const TiXmlElement* p = j->FirstChildElement("parent");
+      const TiXmlElement* c = j->FirstChildElement("child");
+      const char* parent = p != nullptr ? p->Attribute("link") : nullptr;
+      const char* child = c != nullptr ? c->Attribute("link") : nullptr;
+      if (name == nullptr || parent == nullptr || child == nullptr) continue;  // urdfdom says
+      for (const char* l : {parent, child}) {
+        if (!links.contains(l)) {
+          fail(
+              fmt::format("joint '{}' names link '{}', which the file does not declare (a "
+                          "<link name=\"{}\"/> is missing, or the name is misspelt)",
+                          name, l, l));
+        }
+      }
+      if (const auto it = up.find(child); it != up.end()) {
+        fail(fmt::format("link '{}' has two parent joints, '{}' and '{}': a URDF is a tree", child,
+                         it->second.joint, name));
+      }
+      up[child] = {parent, name};
+    }
+    for (const auto& [start, first] : up) {
+      std::vector<std::string> path{start};
+      for (auto it = up.find(start); it != up.end(); it = up.find(it->second.parent)) {
+        path.push_back(it->second.parent);
+        if (it->second.parent == start) {
+          fail(fmt::format("the joints make a cycle: {} (a URDF is a tree)",
+                           fmt::join(path.rbegin(), path.rend(), " -> ")));
+        }
+        if (path.size() > up.size() + 1) break;  // a cycle above start: found from its links
+      }
+    }
+  }
+
+  urdf::ModelInterfaceSharedPtr parse(std::string_view xml) const {
+    CapturedLog log;
+    urdf::ModelInterfaceSharedPtr model;
+    {
+      const std::lock_guard lock(console_mutex());
+      console_bridge::useOutputHandler(&log);
+      try {
+        model = urdf::parseURDF(std::string(xml));
+      } catch (const std::exception& e) {
+        log.lines.push_back(e.what());
+      }
+      console_bridge::restorePreviousOutputHandler();
+    }
+    if (model == nullptr) {
+      // urdfdom says what it found first and then that the element failed: all of it.
+      std::string why =
+          log.lines.empty() ? "not a URDF robot" : fmt::format("{}", fmt::join(log.lines, "; "));
+      // urdfdom's own words for a cycle or a second root are about trees: say what to fix.
+      if (why.find("root") != std::string::npos) {
+        why +=
+            " (a URDF is a tree: every link but one has exactly one parent joint, and no "
+            "chain of joints comes back to a link above it)";
+      }
+      fail(fmt::format("not a usable URDF: {}", why));
+    }
+    return model;
+  }
+
+  /// The links from the base down to the tip (base first), and the base.
+  std::pair<std::vector<urdf::LinkConstSharedPtr>, urdf::LinkConstSharedPtr> chain_links(
+      const urdf::ModelInterface& model) const {
+    urdf::LinkConstSharedPtr base = model.getRoot();
+    if (!options_.base_link.empty()) {
+      base = model.getLink(options_.base_link);
+      if (base == nullptr) fail(fmt::format("no link named '{}' for the base", options_.base_link));
+    }
+    urdf::LinkConstSharedPtr tip;
+    if (!options_.tip_link.empty()) {
+      tip = model.getLink(options_.tip_link);
+      if (tip == nullptr) fail(fmt::format("no link named '{}' for the tip", options_.tip_link));
+    } else {
+      std::vector<std::string> leaves;
+      std::vector<urdf::LinkConstSharedPtr> stack{base};
+      while (!stack.empty()) {
+        const urdf::LinkConstSharedPtr l = stack.back();
+        stack.pop_back();
+        if (l->child_links.empty()) {
+          leaves.push_back(l->name);
+          tip = l;
+        }
+        for (const auto& c : l->child_links) stack.push_back(c);
+      }
+      if (leaves.size() > 1) {
+        std::sort(leaves.begin(), leaves.end());
+        fail(fmt::format("the tree branches below '{}': name the tip link (--tip): one of {}",
+                         base->name, fmt::join(leaves, ", ")));
+      }
+    }
+    std::vector<urdf::LinkConstSharedPtr> chain{tip};
+    while (chain.back() != base) {
+      const urdf::LinkConstSharedPtr parent = chain.back()->getParent();
+      if (parent == nullptr) {
+        fail(fmt::format("link '{}' is not below link '{}': no chain joins them", tip->name,
+                         base->name));
+      }
+      chain.push_back(parent);
+    }
+    std::reverse(chain.begin(), chain.end());
+    return {chain, base};
+  }
+
+  void check_transform(const math::Transform& T, const std::string& what) const {
+    if (!finite(T)) fail(fmt::format("{}: a number that is not finite", what));
+    if (T.p.norm() > kMaxOffset_m) {
+      fail(
+          fmt::format("{}: an offset of {:.4g} m (more than {} m: a typo, or millimetres "
+                      "where URDF has metres?)",
+                      what, T.p.norm(), kMaxOffset_m));
+    }
+  }
+
+  /// The link's mass and centre of mass, placed by `where` into the moving link's frame.
+  void add_inertial(const urdf::Link& link, const math::Transform& where, double& mass,
+                    math::Vec3& moment) const {
+    if (link.inertial == nullptr) return;
+    const double m = link.inertial->mass;
+    if (!std::isfinite(m) || m < 0.0 || m > kMaxMass_kg) {
+      fail(fmt::format("link '{}': mass {} (give 0 to {} kg)", link.name, m, kMaxMass_kg));
+    }
+    const math::Transform com = to_transform(link.inertial->origin);
+    check_transform(com, fmt::format("link '{}''s inertial origin", link.name));
+    mass += m;
+    moment += (where * com.p) * m;
+  }
+
+  RobotModel build(const urdf::ModelInterface& model,
+                   const std::vector<urdf::LinkConstSharedPtr>& chain,
+                   const urdf::LinkConstSharedPtr& base) const {
+    RobotModel out;
+    out.name = model.getName();
+    out.title = fmt::format("from {}", origin_);
+    out.source = fmt::format("URDF {}, links {} to {}", origin_, base->name, chain.back()->name);
+    out.geometry = Geometry::chain;
+    out.solver = SolverKind::dh;  // the numeric solver, for any chain
+    // From the frame of the current moving link (or the base) to the link being read.
+    math::Transform pending;
+    double mass = 0.0;
+    math::Vec3 moment;
+    const auto close_link = [&](Joint* j) {
+      if (j == nullptr) return;  // the base's own mass moves with nothing
+      j->dynamics.link_mass_kg = mass;
+      const math::Vec3 com = mass > 0.0 ? moment / mass : math::Vec3{};
+      j->dynamics.link_com_m = {com.x, com.y, com.z};
+    };
+    for (std::size_t k = 1; k < chain.size(); ++k) {
+      const urdf::Link& link = *chain[k];
+      const urdf::Joint& uj = *link.parent_joint;
+      const std::string what = fmt::format("joint '{}'", uj.name);
+      const math::Transform origin = to_transform(uj.parent_to_joint_origin_transform);
+      check_transform(origin, what + "'s origin");
+      if (uj.mimic != nullptr) {
+        fail(
+            fmt::format("{} mimics joint '{}': mimic joints are not read (the chain's joints "
+                        "move independently); make it fixed or revolute",
+                        what, uj.mimic->joint_name));
+      }
+      if (uj.type == urdf::Joint::FIXED) {
+        pending = pending * origin;
+        add_inertial(link, pending, mass, moment);
+        continue;
+      }
+      if (uj.type != urdf::Joint::REVOLUTE && uj.type != urdf::Joint::CONTINUOUS &&
+          uj.type != urdf::Joint::PRISMATIC) {
+        const char* kind = uj.type == urdf::Joint::FLOATING ? "floating"
+                           : uj.type == urdf::Joint::PLANAR ? "planar"
+                                                            : "of an unknown type";
+        fail(
+            fmt::format("{} is {}: rccx reads serial arms of revolute, continuous, prismatic "
+                        "and fixed joints",
+                        what, kind));
+      }
+      if (out.joints.size() == kMaxJoints) {
+        fail(fmt::format("more than {} moving joints between '{}' and '{}'", kMaxJoints, base->name,
+                         chain.back()->name));
+      }
+      close_link(out.joints.empty() ? nullptr : &out.joints.back());
+      Joint j;
+      j.name = uj.name;
+      j.type = uj.type == urdf::Joint::PRISMATIC ? JointType::prismatic : JointType::revolute;
+      j.chain.origin = pending * origin;
+      const math::Vec3 axis{uj.axis.x, uj.axis.y, uj.axis.z};
+      if (!std::isfinite(axis.norm()) || axis.norm() < 1e-9) {
+        fail(fmt::format("{}: axis ({} {} {}) is not a direction", what, axis.x, axis.y, axis.z));
+      }
+      j.chain.axis = axis.normalized();
+      j.continuous = uj.type == urdf::Joint::CONTINUOUS;
+      if (j.continuous) {
+        j.lower = -std::numeric_limits<double>::infinity();
+        j.upper = std::numeric_limits<double>::infinity();
+      } else {
+        if (uj.limits == nullptr) fail(fmt::format("{} has no <limit>", what));
+        j.lower = uj.limits->lower;
+        j.upper = uj.limits->upper;
+        if (!std::isfinite(j.lower) || !std::isfinite(j.upper) || j.lower > j.upper ||
+            std::abs(j.lower) > kMaxLimit || std::abs(j.upper) > kMaxLimit) {
+          fail(
+              fmt::format("{}: limits lower {} upper {} (finite, lower <= upper, within {} "
+                          "rad or m)",
+                          what, j.lower, j.upper, kMaxLimit));
+        }
+      }
+      if (uj.limits != nullptr) {
+        const double v = uj.limits->velocity, e = uj.limits->effort;
+        if (!std::isfinite(v) || !std::isfinite(e) || v < 0.0 || e < 0.0) {
+          fail(fmt::format("{}: velocity {} and effort {} must be finite and >= 0", what, v, e));
+        }
+        j.max_velocity = v;
+        j.dynamics.max_effort = e;
+      }
+      // URDF has no encoders: a 20-bit one per turn, or 1 um, until a robot file says better.
+      j.resolution_per_count =
+          j.type == JointType::revolute ? 2.0 * std::numbers::pi / (1 << 20) : 1e-6;
+      // URDF has no ready pose: the middle of each joint's range (0 for a continuous joint),
+      // away from the limits, and a numeric solver's first seed.
+      j.ready = j.continuous ? 0.0 : 0.5 * (j.lower + j.upper);
+      out.joints.push_back(std::move(j));
+      pending = math::Transform{};
+      mass = 0.0;
+      moment = {};
+      add_inertial(link, pending, mass, moment);
+    }
+    if (out.joints.empty()) {
+      fail(fmt::format("no moving joint between '{}' and '{}'", base->name, chain.back()->name));
+    }
+    // The fixed joints out to the tip: the flange, in the last joint's `after`. The last link's
+    // centre of mass was gathered in its own frame; T6 is the flange's.
+    Joint& last = out.joints.back();
+    last.chain.after = pending;
+    if (mass > 0.0) moment = pending.inverse() * (moment / mass) * mass;
+    close_link(&last);
+    return out;
+  }
+
+  std::string origin_;
+  UrdfOptions options_;
+};
+
+}  // namespace
+
+RobotModel parse_urdf(std::string_view xml, std::string_view origin, const UrdfOptions& options) {
+  return Reader(origin, options).read(xml);
+}
+
+RobotModel load_urdf(const std::filesystem::path& path, const UrdfOptions& options) {
+  std::error_code ec;
+  const auto size = std::filesystem::file_size(path, ec);
+  if (ec) {
+    throw RobotFileError(fmt::format("{}: cannot read: {}", path.string(), ec.message()));
+  }
+  if (size > kMaxUrdfBytes) {
+    throw RobotFileError(fmt::format("{}: {} bytes, more than the {} MB a URDF may have here",
+                                     path.string(), size, kMaxUrdfBytes >> 20));
+  }
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (!in) throw RobotFileError(fmt::format("{}: cannot read", path.string()));
+  return parse_urdf(text.str(), path.string(), options);
+}
+
+bool is_urdf_path(const std::filesystem::path& path) {
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return std::tolower(c); });
+  return ext == ".urdf";
+}
+
+}  // namespace rccx::kin

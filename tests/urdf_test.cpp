@@ -1,0 +1,297 @@
+// URDF robots (kin::load_urdf): forward kinematics and Jacobians of the shipped UR5e, Panda and
+// PUMA 560 URDFs against KDL chains this test builds from the same files on its own (urdfdom's
+// tree walked as kdl_parser walks it: each joint a KDL::Joint about its axis in the joint
+// frame, each segment's frame the joint origin), the PUMA's URDF against rccx's closed form,
+// and bad files refused with messages that say what is wrong.
+#include <gtest/gtest.h>
+
+#include <urdf_parser/urdf_parser.h>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <kdl/chain.hpp>
+#include <kdl/chainfksolverpos_recursive.hpp>
+#include <kdl/chainjnttojacsolver.hpp>
+#include <random>
+#include <string>
+
+#include "rccx/kinematics/kinematics.hpp"
+#include "rccx/kinematics/link_frames.hpp"
+#include "rccx/kinematics/urdf.hpp"
+#include "rccx/math/units.hpp"
+
+namespace kin = rccx::kin;
+namespace math = rccx::math;
+
+namespace {
+
+const std::filesystem::path kRobots = RCCX_ROBOTS_DIR;
+
+KDL::Frame kdl_frame(const urdf::Pose& p) {
+  return {KDL::Rotation::Quaternion(p.rotation.x, p.rotation.y, p.rotation.z, p.rotation.w),
+          KDL::Vector(p.position.x, p.position.y, p.position.z)};
+}
+
+/// The KDL chain from `base` to `tip` of a URDF file, built as kdl_parser builds it.
+KDL::Chain kdl_chain_from_urdf(const std::filesystem::path& file, const std::string& base,
+                               const std::string& tip) {
+  const urdf::ModelInterfaceSharedPtr model = urdf::parseURDFFile(file.string());
+  EXPECT_NE(model, nullptr) << file;
+  std::vector<urdf::LinkConstSharedPtr> links{model->getLink(tip)};
+  while (links.back()->name != base) links.push_back(links.back()->getParent());
+  KDL::Chain chain;
+  for (auto it = links.rbegin() + 1; it != links.rend(); ++it) {
+    const urdf::Joint& j = *(*it)->parent_joint;
+    const KDL::Frame origin = kdl_frame(j.parent_to_joint_origin_transform);
+    const KDL::Vector axis(j.axis.x, j.axis.y, j.axis.z);
+    KDL::Joint joint(j.name, KDL::Joint::Fixed);
+    if (j.type == urdf::Joint::REVOLUTE || j.type == urdf::Joint::CONTINUOUS) {
+      joint = KDL::Joint(j.name, origin.p, origin.M * axis, KDL::Joint::RotAxis);
+    } else if (j.type == urdf::Joint::PRISMATIC) {
+      joint = KDL::Joint(j.name, origin.p, origin.M * axis, KDL::Joint::TransAxis);
+    }
+    chain.addSegment(KDL::Segment((*it)->name, joint, origin));
+  }
+  return chain;
+}
+
+double max_difference(const math::Transform& T, const KDL::Frame& F) {
+  double worst = 0.0;
+  for (int r = 0; r < 3; ++r) {
+    worst = std::max(worst, std::abs(T.p[r] - F.p(r)));
+    for (int c = 0; c < 3; ++c) worst = std::max(worst, std::abs(T.R(r, c) - F.M(r, c)));
+  }
+  return worst;
+}
+
+kin::JointVector random_within_limits(const kin::RobotModel& m, std::mt19937_64& rng) {
+  kin::JointVector q(m.dof());
+  for (std::size_t i = 0; i < m.dof(); ++i) {
+    const double lo = std::isfinite(m.joints[i].lower) ? m.joints[i].lower : -math::kPi;
+    const double hi = std::isfinite(m.joints[i].upper) ? m.joints[i].upper : math::kPi;
+    q[i] = std::uniform_real_distribution<double>(lo, hi)(rng);
+  }
+  return q;
+}
+
+struct Case {
+  const char* file;
+  const char* base;
+  const char* tip;
+  std::size_t dof;
+};
+
+class UrdfAgainstKdl : public testing::TestWithParam<Case> {};
+
+TEST_P(UrdfAgainstKdl, ForwardAndJacobianAgreeOver10000RandomConfigurations) {
+  const Case c = GetParam();
+  const kin::RobotModel model = kin::load_urdf(kRobots / c.file);
+  ASSERT_EQ(model.dof(), c.dof);
+  EXPECT_EQ(model.geometry, kin::Geometry::chain);
+  const auto k = kin::make_kinematics(model);
+  const KDL::Chain chain = kdl_chain_from_urdf(kRobots / c.file, c.base, c.tip);
+  ASSERT_EQ(chain.getNrOfJoints(), c.dof);
+  KDL::ChainFkSolverPos_recursive fk(chain);
+  KDL::ChainJntToJacSolver jac(chain);
+  std::mt19937_64 rng(26);
+  const kin::DhChain links(model);
+  double worst_pose = 0.0, worst_jacobian = 0.0, worst_link = 0.0;
+  for (int n = 0; n < 10'000; ++n) {
+    const kin::JointVector q = random_within_limits(model, rng);
+    KDL::JntArray jq(static_cast<unsigned>(q.size()));
+    for (std::size_t i = 0; i < q.size(); ++i) jq(static_cast<unsigned>(i)) = q[i];
+    KDL::Frame F;
+    ASSERT_GE(fk.JntToCart(jq, F), 0);
+    worst_pose = std::max(worst_pose, max_difference(k->forward(q), F));
+    // Every link frame (the collision capsules' and the view's): KDL's segment i is link i
+    // (these chains have no fixed joint but the flange, the last frame).
+    std::array<math::Transform, kin::kMaxJoints> frames;
+    kin::link_frames(links, q, frames);
+    for (std::size_t i = 0; i + 1 < q.size(); ++i) {
+      KDL::Frame Fi;
+      ASSERT_GE(fk.JntToCart(jq, Fi, static_cast<int>(i + 1)), 0);
+      worst_link = std::max(worst_link, max_difference(frames[i], Fi));
+    }
+    worst_link = std::max(worst_link, max_difference(frames[q.size() - 1], F));
+    KDL::Jacobian J(static_cast<unsigned>(q.size()));
+    ASSERT_GE(jac.JntToJac(jq, J), 0);
+    const kin::Jacobian mine = k->jacobian(q);
+    for (int r = 0; r < 6; ++r) {
+      for (std::size_t i = 0; i < q.size(); ++i) {
+        const auto col = static_cast<Eigen::Index>(i);
+        worst_jacobian = std::max(
+            worst_jacobian,
+            std::abs(mine(r, col) - J(static_cast<unsigned>(r), static_cast<unsigned>(i))));
+      }
+    }
+  }
+  EXPECT_LE(worst_pose, 1e-12) << c.file;
+  EXPECT_LE(worst_jacobian, 1e-12) << c.file;
+  EXPECT_LE(worst_link, 1e-12) << c.file;
+  RecordProperty("worst_pose_difference", std::to_string(worst_pose));
+}
+
+INSTANTIATE_TEST_SUITE_P(ShippedRobots, UrdfAgainstKdl,
+                         testing::Values(Case{"ur5e.urdf", "base_link", "tool0", 6},
+                                         Case{"panda.urdf", "panda_link0", "panda_link8", 7},
+                                         Case{"puma560.urdf", "base_link", "flange", 6}),
+                         [](const auto& test) {
+                           std::string name = test.param.file;
+                           return name.substr(0, name.find('.'));
+                         });
+
+TEST(Urdf, ThePuma560UrdfIsRccxsClosedFormPuma) {
+  const kin::RobotModel urdf = kin::load_urdf(kRobots / "puma560.urdf");
+  const kin::RobotModel dh = kin::builtin_robot("puma560");
+  ASSERT_EQ(urdf.dof(), dh.dof());
+  for (std::size_t i = 0; i < dh.dof(); ++i) {
+    EXPECT_NEAR(urdf.joints[i].lower, dh.joints[i].lower, 1e-12) << i;
+    EXPECT_NEAR(urdf.joints[i].upper, dh.joints[i].upper, 1e-12) << i;
+    EXPECT_NEAR(urdf.joints[i].max_velocity, dh.joints[i].max_velocity, 1e-12) << i;
+    EXPECT_NEAR(urdf.joints[i].dynamics.link_mass_kg, dh.joints[i].dynamics.link_mass_kg, 1e-12);
+  }
+  const auto closed = kin::make_kinematics(dh);
+  const auto chain = kin::make_kinematics(urdf);
+  std::mt19937_64 rng(560);
+  double worst = 0.0;
+  for (int n = 0; n < 10'000; ++n) {
+    const kin::JointVector q = random_within_limits(dh, rng);
+    const auto a = closed->forward(q).rows();
+    const auto b = chain->forward(q).rows();
+    for (std::size_t e = 0; e < a.size(); ++e) worst = std::max(worst, std::abs(a[e] - b[e]));
+  }
+  EXPECT_LE(worst, 1e-12);
+}
+
+TEST(Urdf, TheNumericSolverRoundTripsTheImportedArms) {
+  for (const char* file : {"ur5e.urdf", "panda.urdf"}) {
+    const kin::RobotModel model = kin::load_urdf(kRobots / file);
+    const auto k = kin::make_kinematics(model);
+    std::mt19937_64 rng(7);
+    int solved = 0;
+    const int n = 200;
+    for (int t = 0; t < n; ++t) {
+      const kin::JointVector q = random_within_limits(model, rng);
+      const math::Transform T = k->forward(q);
+      kin::JointVector near = q;
+      for (double& v : near) v += 0.05;  // a seed close by, as the generator gives one
+      const kin::IkResult r = k->inverse(T, {.configuration = std::nullopt, .near = near});
+      if (!r) continue;
+      ++solved;
+      const auto a = k->forward(r.q).rows();
+      const auto b = T.rows();
+      for (std::size_t e = 0; e < a.size(); ++e) ASSERT_NEAR(a[e], b[e], 1e-9) << file;
+      EXPECT_TRUE(model.within_limits(r.q, 1e-9)) << file;
+    }
+    EXPECT_GE(solved, n * 95 / 100) << file;
+  }
+}
+
+TEST(Urdf, ContinuousJointsHaveNoLimitsAndFixedOnesAreLumped) {
+  const std::string xml = R"(<robot name="two">
+    <link name="base"/><link name="a"/><link name="b"/><link name="c"/>
+    <joint name="spin" type="continuous"><parent link="base"/><child link="a"/>
+      <origin xyz="0 0 0.5"/><axis xyz="0 0 1"/></joint>
+    <joint name="bracket" type="fixed"><parent link="a"/><child link="b"/>
+      <origin xyz="0.1 0 0" rpy="0 1.5707963267948966 0"/></joint>
+    <joint name="slide" type="prismatic"><parent link="b"/><child link="c"/>
+      <origin xyz="0 0 0.2"/><axis xyz="1 0 0"/>
+      <limit lower="-0.1" upper="0.3" velocity="0.5" effort="100"/></joint>
+  </robot>)";
+  const kin::RobotModel m = kin::parse_urdf(xml, "two.urdf");
+  ASSERT_EQ(m.dof(), 2u);
+  EXPECT_TRUE(m.joints[0].continuous);
+  EXPECT_TRUE(std::isinf(m.joints[0].lower) && std::isinf(m.joints[0].upper));
+  EXPECT_EQ(m.joints[1].type, kin::JointType::prismatic);
+  EXPECT_DOUBLE_EQ(m.joints[1].upper, 0.3);
+  const auto k = kin::make_kinematics(m);
+  // Turned 90 deg about z, the bracket's 0.1 m and the slide's 0.2 m offset (turned to x by
+  // the bracket's pitch) point along y; the slide's 0.3 m along its x, pitched, points down.
+  const math::Transform T = k->forward(kin::JointVector{math::kPi / 2, 0.3});
+  EXPECT_NEAR(T.p.x, 0.0, 1e-12);
+  EXPECT_NEAR(T.p.y, 0.1 + 0.2, 1e-12);
+  EXPECT_NEAR(T.p.z, 0.5 - 0.3, 1e-12);
+}
+
+std::string error_of(const std::string& xml, const kin::UrdfOptions& options = {}) {
+  try {
+    (void)kin::parse_urdf(xml, "bad.urdf", options);
+  } catch (const kin::RobotFileError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+const char* const kTwoLinks = R"(<robot name="r">
+  <link name="base"/><link name="a"/>
+  <joint name="j1" type="revolute"><parent link="base"/><child link="a"/>
+    <origin xyz="X Y Z" rpy="0 0 0"/><axis xyz="0 0 1"/>
+    <limit lower="-1" upper="1" velocity="1" effort="1"/></joint>
+</robot>)";
+
+std::string two_links(const std::string& xyz) {
+  std::string s = kTwoLinks;
+  s.replace(s.find("X Y Z"), 5, xyz);
+  return s;
+}
+
+TEST(UrdfBadInput, EachBadFileIsRefusedSayingWhatIsWrong) {
+  EXPECT_NE(error_of(two_links("0 0 nan")).find("Unable to parse component [nan]"),
+            std::string::npos)
+      << error_of(two_links("0 0 nan"));
+  EXPECT_NE(error_of(two_links("0 0 1e9")).find("more than 100 m"), std::string::npos)
+      << error_of(two_links("0 0 1e9"));
+  const std::string cycle = R"(<robot name="r"><link name="a"/><link name="b"/>
+    <joint name="ab" type="fixed"><parent link="a"/><child link="b"/></joint>
+    <joint name="ba" type="fixed"><parent link="b"/><child link="a"/></joint></robot>)";
+  EXPECT_NE(error_of(cycle).find("the joints make a cycle: a -> b -> a"), std::string::npos)
+      << error_of(cycle);
+  const std::string orphan = R"(<robot name="r"><link name="a"/>
+    <joint name="j" type="fixed"><parent link="nobody"/><child link="a"/></joint></robot>)";
+  EXPECT_NE(error_of(orphan).find("joint 'j' names link 'nobody', which the file does not declare"),
+            std::string::npos)
+      << error_of(orphan);
+  const std::string branches =
+      R"(<robot name="r"><link name="base"/><link name="l"/><link name="r"/>
+    <joint name="jl" type="continuous"><parent link="base"/><child link="l"/></joint>
+    <joint name="jr" type="continuous"><parent link="base"/><child link="r"/></joint></robot>)";
+  EXPECT_NE(error_of(branches).find("name the tip link (--tip): one of l, r"), std::string::npos)
+      << error_of(branches);
+  EXPECT_EQ(kin::parse_urdf(branches, "ok", {.base_link = "", .tip_link = "r"}).joints[0].name,
+            "jr");
+  EXPECT_NE(
+      error_of(branches, {.base_link = "", .tip_link = "nowhere"}).find("no link named 'nowhere'"),
+      std::string::npos);
+  const std::string floating = R"(<robot name="r"><link name="base"/><link name="a"/>
+    <joint name="free" type="floating"><parent link="base"/><child link="a"/></joint></robot>)";
+  EXPECT_NE(error_of(floating).find("joint 'free' is floating"), std::string::npos)
+      << error_of(floating);
+  const std::string mimic = R"(<robot name="r"><link name="base"/><link name="a"/><link name="b"/>
+    <joint name="j1" type="continuous"><parent link="base"/><child link="a"/></joint>
+    <joint name="j2" type="continuous"><parent link="a"/><child link="b"/>
+      <mimic joint="j1" multiplier="2"/></joint></robot>)";
+  EXPECT_NE(error_of(mimic).find("mimics joint 'j1'"), std::string::npos) << error_of(mimic);
+  const std::string xacro = R"(<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro">
+    <xacro:property name="a" value="1"/></robot>)";
+  EXPECT_NE(error_of(xacro).find("run `xacro"), std::string::npos) << error_of(xacro);
+  EXPECT_NE(error_of("<robot").find("not a usable URDF"), std::string::npos);
+  std::string huge(kin::kMaxUrdfBytes + 1, ' ');
+  EXPECT_NE(error_of(huge).find("MB a URDF may have"), std::string::npos);
+  std::string no_limit = two_links("0 0 0");
+  no_limit.replace(no_limit.find("<limit"),
+                   no_limit.find("/></joint>") - no_limit.find("<limit") + 2, "");
+  EXPECT_NE(error_of(no_limit).find("REVOLUTE but it does not specify limits"), std::string::npos)
+      << error_of(no_limit);
+}
+
+TEST(UrdfBadInput, AMissingFileSaysSo) {
+  try {
+    (void)kin::load_urdf("/nonexistent/robot.urdf");
+    FAIL() << "no error";
+  } catch (const kin::RobotFileError& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/robot.urdf: cannot read"), std::string::npos)
+        << e.what();
+  }
+}
+
+}  // namespace
