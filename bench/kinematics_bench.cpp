@@ -24,6 +24,7 @@
 
 #include "rccx/kinematics/dh_kinematics.hpp"
 #include "rccx/kinematics/kinematics.hpp"
+#include "rccx/kinematics/urdf.hpp"
 #include "rccx/math/transform.hpp"
 
 namespace {
@@ -55,6 +56,17 @@ const Kinematics& puma() {
   static const auto k = rccx::kin::make_kinematics(rccx::kin::builtin_robot("puma560"));
   return *k;
 }
+/// The UR5e from robots/ur5e.urdf: its closed form (recognised on the URDF's DH table), the
+/// numeric solver forced on it, and KDL's chain of the same URDF.
+const Kinematics& ur5e() {
+  static const auto k =
+      rccx::kin::make_kinematics(rccx::kin::load_urdf(RCCX_ROBOTS_DIR "/ur5e.urdf"));
+  return *k;
+}
+const rccx::kin::DhKinematics& numeric_ur5e() {
+  static const rccx::kin::DhKinematics k(ur5e().model());
+  return k;
+}
 const rccx::kin::DhKinematics& dh_puma() {
   static const rccx::kin::DhKinematics dh(rccx::kin::builtin_robot("puma560"));
   return dh;
@@ -80,8 +92,9 @@ JointVector from_kdl(const KDL::JntArray& a) {
   return q;
 }
 
-/// The KDL peer, its chain built from the same DH table as our PUMA 560 model. Not movable:
-/// the solvers keep a reference to the chain.
+/// The KDL peer, its chain built from the same DH table as our model, or from the same
+/// general chain (a URDF's: each joint about its axis at its origin, as kdl_parser builds it).
+/// Not movable: the solvers keep a reference to the chain.
 struct KdlPuma {
   KDL::Chain chain;
   std::unique_ptr<KDL::ChainFkSolverPos_recursive> fk;
@@ -90,9 +103,22 @@ struct KdlPuma {
   explicit KdlPuma(const RobotModel& model) {
     for (const auto& j : model.joints) {
       const bool prismatic = j.type == rccx::kin::JointType::prismatic;
+      if (model.geometry == rccx::kin::Geometry::chain) {
+        const KDL::Frame origin = to_kdl(j.chain.origin);
+        const KDL::Vector axis =
+            origin.M * KDL::Vector(j.chain.axis.x, j.chain.axis.y, j.chain.axis.z);
+        chain.addSegment(KDL::Segment(
+            KDL::Joint(origin.p, axis, prismatic ? KDL::Joint::TransAxis : KDL::Joint::RotAxis),
+            origin));
+        continue;
+      }
       chain.addSegment(
           KDL::Segment(KDL::Joint(prismatic ? KDL::Joint::TransZ : KDL::Joint::RotZ),
                        KDL::Frame::DH(j.dh.a_m, j.dh.alpha_rad, j.dh.d_m, j.dh.theta_rad)));
+    }
+    if (model.geometry == rccx::kin::Geometry::chain) {  // the flange
+      chain.addSegment(
+          KDL::Segment(KDL::Joint(KDL::Joint::Fixed), to_kdl(model.joints.back().chain.after)));
     }
     fk = std::make_unique<KDL::ChainFkSolverPos_recursive>(chain);
     ik = std::make_unique<KDL::ChainIkSolverPos_LMA>(chain);  // KDL's defaults: eps 1e-5, 500 it.
@@ -102,6 +128,10 @@ struct KdlPuma {
 };
 KdlPuma& kdl_puma() {
   static KdlPuma k(puma().model());
+  return k;
+}
+KdlPuma& kdl_ur5e() {
+  static KdlPuma k(ur5e().model());
   return k;
 }
 
@@ -213,6 +243,10 @@ const IkPool& puma_ik_pool() {
   static const IkPool pool = make_ik_pool(puma());
   return pool;
 }
+const IkPool& ur5e_ik_pool() {
+  static const IkPool pool = make_ik_pool(ur5e());
+  return pool;
+}
 
 // ---- sanity checks (each computed once, then cached) --------------------------------------
 
@@ -272,7 +306,7 @@ struct NumericCheck {
   double max_error = 0.0;  // over the successful answers: max |FK(q) - pose| element
 };
 
-NumericCheck check_dh_ik(const IkPool& pool) {
+NumericCheck check_dh_ik(const IkPool& pool, const rccx::kin::DhKinematics& dh = dh_puma()) {
   NumericCheck c;
   if (!pool.error.empty()) {
     c.error = pool.error;
@@ -280,10 +314,10 @@ NumericCheck check_dh_ik(const IkPool& pool) {
   }
   std::size_t ok = 0;
   for (std::size_t s = 0; s < pool.pose.size(); ++s) {
-    const IkResult r = dh_puma().inverse(pool.pose[s], pool.seeded[s]);
+    const IkResult r = dh.inverse(pool.pose[s], pool.seeded[s]);
     if (!r) continue;
     ++ok;
-    c.max_error = std::max(c.max_error, max_diff(dh_puma().forward(r.q), pool.pose[s]));
+    c.max_error = std::max(c.max_error, max_diff(dh.forward(r.q), pool.pose[s]));
   }
   c.ok_rate = static_cast<double>(ok) / static_cast<double>(pool.pose.size());
   if (ok == 0) c.error = "the DH solver solved no sample";
@@ -295,20 +329,20 @@ NumericCheck check_dh_ik(const IkPool& pool) {
 
 /// KDL's LMA stops when |L .* twist error| < eps (1e-5) with weights L = (1, 1, 1, 0.01, 0.01,
 /// 0.01): its answers are good to about 1e-5 m and 1e-3 rad, and are checked to that.
-NumericCheck check_kdl_ik(const IkPool& pool) {
+NumericCheck check_kdl_ik(const IkPool& pool, KdlPuma& kdl = kdl_puma(),
+                          const Kinematics& ours = puma()) {
   NumericCheck c;
   if (!pool.error.empty()) {
     c.error = pool.error;
     return c;
   }
-  KdlPuma& kdl = kdl_puma();
   KDL::JntArray q_out(kdl.chain.getNrOfJoints());
   std::size_t ok = 0;
   double max_position = 0.0, max_rotation = 0.0;
   for (std::size_t s = 0; s < pool.pose.size(); ++s) {
     if (kdl.ik->CartToJnt(pool.kdl_seed[s], pool.kdl_pose[s], q_out) < 0) continue;
     ++ok;
-    const Transform t = puma().forward(from_kdl(q_out));
+    const Transform t = ours.forward(from_kdl(q_out));
     max_position = std::max(max_position, (t.p - pool.pose[s].p).norm());
     Transform rotation_only = t;
     rotation_only.p = pool.pose[s].p;
@@ -476,6 +510,71 @@ void BM_KdlPuma560IK(benchmark::State& state) {
   state.counters["max_err"] = check.max_error;
 }
 
+// ---- the UR5e from its URDF (issue 26): closed form, numeric, KDL on the same poses ---------
+
+void BM_Ur5eIK(benchmark::State& state) {
+  static const std::string error = check_ik_one(ur5e(), ur5e_ik_pool());
+  if (!checked(state, error)) return;
+  run_ik_one(state, ur5e(), ur5e_ik_pool());
+}
+
+void BM_Ur5eIKAll(benchmark::State& state) {
+  static const std::string error = check_ik_all(ur5e(), ur5e_ik_pool());
+  if (!checked(state, error)) return;
+  const IkPool& pool = ur5e_ik_pool();
+  std::size_t i = 0;
+  std::int64_t solutions = 0;
+  for (auto _ : state) {
+    const auto all = ur5e().inverse_all(pool.pose[i]);
+    benchmark::DoNotOptimize(all);
+    solutions += static_cast<std::int64_t>(all.count);
+    if (++i == pool.pose.size()) i = 0;
+  }
+  pool_counters(state, pool);
+  state.counters["solutions"] =
+      benchmark::Counter(static_cast<double>(solutions), benchmark::Counter::kAvgIterations);
+}
+
+/// The numeric solver forced on the UR5e, from the seeds KDL gets (0.05 rad off each joint).
+void BM_Ur5eNumericIK(benchmark::State& state) {
+  static const NumericCheck check = check_dh_ik(ur5e_ik_pool(), numeric_ur5e());
+  if (!checked(state, check.error)) return;
+  const IkPool& pool = ur5e_ik_pool();
+  std::size_t i = 0;
+  std::int64_t ok = 0;
+  for (auto _ : state) {
+    const IkResult r = numeric_ur5e().inverse(pool.pose[i], pool.seeded[i]);
+    benchmark::DoNotOptimize(r);
+    ok += r ? 1 : 0;
+    if (++i == pool.pose.size()) i = 0;
+  }
+  pool_counters(state, pool);
+  state.counters["ok_rate"] =
+      benchmark::Counter(static_cast<double>(ok), benchmark::Counter::kAvgIterations);
+  state.counters["max_err"] = check.max_error;
+}
+
+void BM_KdlUr5eIK(benchmark::State& state) {
+  static const NumericCheck check = check_kdl_ik(ur5e_ik_pool(), kdl_ur5e(), ur5e());
+  if (!checked(state, check.error)) return;
+  KdlPuma& kdl = kdl_ur5e();
+  const IkPool& pool = ur5e_ik_pool();
+  std::size_t i = 0;
+  std::int64_t ok = 0;
+  KDL::JntArray q_out(kdl.chain.getNrOfJoints());
+  for (auto _ : state) {
+    const int rc = kdl.ik->CartToJnt(pool.kdl_seed[i], pool.kdl_pose[i], q_out);
+    benchmark::DoNotOptimize(rc);
+    benchmark::DoNotOptimize(q_out);
+    ok += rc >= 0 ? 1 : 0;
+    if (++i == pool.pose.size()) i = 0;
+  }
+  pool_counters(state, pool);
+  state.counters["ok_rate"] =
+      benchmark::Counter(static_cast<double>(ok), benchmark::Counter::kAvgIterations);
+  state.counters["max_err"] = check.max_error;
+}
+
 }  // namespace
 
 BENCHMARK(BM_MicroboFK);
@@ -487,5 +586,9 @@ BENCHMARK(BM_DhFK);
 BENCHMARK(BM_DhIK);
 BENCHMARK(BM_KdlPuma560FK);
 BENCHMARK(BM_KdlPuma560IK);
+BENCHMARK(BM_Ur5eIK);
+BENCHMARK(BM_Ur5eIKAll);
+BENCHMARK(BM_Ur5eNumericIK);
+BENCHMARK(BM_KdlUr5eIK);
 
 BENCHMARK_MAIN();

@@ -6,7 +6,9 @@
 #include <gtest/gtest.h>
 
 #include <urdf_parser/urdf_parser.h>
+#include <array>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <kdl/chain.hpp>
@@ -15,8 +17,11 @@
 #include <random>
 #include <string>
 
+#include "rccx/kinematics/dh_equivalent.hpp"
+#include "rccx/kinematics/dh_kinematics.hpp"
 #include "rccx/kinematics/kinematics.hpp"
 #include "rccx/kinematics/link_frames.hpp"
+#include "rccx/kinematics/ur_kinematics.hpp"
 #include "rccx/kinematics/urdf.hpp"
 #include "rccx/math/units.hpp"
 
@@ -211,6 +216,186 @@ TEST(Urdf, ContinuousJointsHaveNoLimitsAndFixedOnesAreLumped) {
   EXPECT_NEAR(T.p.x, 0.0, 1e-12);
   EXPECT_NEAR(T.p.y, 0.1 + 0.2, 1e-12);
   EXPECT_NEAR(T.p.z, 0.5 - 0.3, 1e-12);
+}
+
+/// The largest element difference of two poses.
+double difference(const math::Transform& a, const math::Transform& b) {
+  double worst = 0.0;
+  const auto ra = a.rows(), rb = b.rows();
+  for (std::size_t e = 0; e < ra.size(); ++e) worst = std::max(worst, std::abs(ra[e] - rb[e]));
+  return worst;
+}
+
+TEST(DhEquivalent, BaseTimesTheTableTimesToolIsTheChainAnywhereItIsPlaced) {
+  std::mt19937_64 rng(1986);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (const char* file : {"ur5e.urdf", "panda.urdf", "puma560.urdf"}) {
+    for (const bool moved : {false, true}) {
+      kin::RobotModel chain = kin::load_urdf(kRobots / file);
+      if (moved) {  // the same arm mounted elsewhere, with a tool: the table must not change
+        const math::Transform mount{math::Rot3::from_urdf_rpy(u(rng), u(rng), u(rng)),
+                                    {u(rng), u(rng), u(rng)}};
+        const math::Transform tool{math::Rot3::from_urdf_rpy(u(rng), u(rng), u(rng)),
+                                   {0.1 * u(rng), 0.1 * u(rng), 0.2}};
+        chain.joints.front().chain.origin = mount * chain.joints.front().chain.origin;
+        chain.joints.back().chain.after = chain.joints.back().chain.after * tool;
+      }
+      const auto dh = kin::dh_equivalent(chain);
+      ASSERT_TRUE(dh.has_value()) << file;
+      EXPECT_EQ(dh->model.geometry, kin::Geometry::dh);
+      const auto by_chain = kin::make_kinematics(chain);
+      const auto by_table = kin::make_kinematics(dh->model);
+      double worst = 0.0;
+      for (int n = 0; n < 2'000; ++n) {
+        const kin::JointVector q = random_within_limits(chain, rng);
+        worst = std::max(
+            worst, difference(dh->base * by_table->forward(q) * dh->tool, by_chain->forward(q)));
+      }
+      EXPECT_LE(worst, 1e-12) << file << (moved ? ", moved" : "");
+    }
+  }
+}
+
+TEST(DhEquivalent, ATableWrittenAsUrdfComesBackAsItWas) {
+  const auto puma = kin::dh_equivalent(kin::load_urdf(kRobots / "puma560.urdf"));
+  ASSERT_TRUE(puma.has_value());
+  const kin::RobotModel table = kin::builtin_robot("puma560");
+  for (std::size_t i = 0; i < table.dof(); ++i) {
+    EXPECT_NEAR(puma->model.joints[i].dh.a_m, table.joints[i].dh.a_m, 1e-12) << i;
+    EXPECT_NEAR(puma->model.joints[i].dh.alpha_rad, table.joints[i].dh.alpha_rad, 1e-12) << i;
+    EXPECT_NEAR(puma->model.joints[i].dh.d_m, table.joints[i].dh.d_m, 1e-12) << i;
+    EXPECT_NEAR(puma->model.joints[i].dh.theta_rad, table.joints[i].dh.theta_rad, 1e-12) << i;
+  }
+  EXPECT_LE(difference(puma->base, {}), 1e-12);
+  EXPECT_LE(difference(puma->tool, {}), 1e-12);
+  // The UR5e's published table (d1, a2, a3, d4, d5, d6; alpha 90, 0, 0, 90, -90, 0 deg).
+  const auto ur = kin::dh_equivalent(kin::load_urdf(kRobots / "ur5e.urdf"));
+  ASSERT_TRUE(ur.has_value());
+  const double a[] = {0, -0.425, -0.3922, 0, 0, 0};
+  const double d[] = {0.1625, 0, 0, 0.1333, 0.0997, 0.0996};
+  const double alpha[] = {math::kPi / 2, 0, 0, math::kPi / 2, -math::kPi / 2, 0};
+  for (std::size_t i = 0; i < 6; ++i) {
+    EXPECT_NEAR(ur->model.joints[i].dh.a_m, a[i], 1e-12) << i;
+    EXPECT_NEAR(ur->model.joints[i].dh.d_m, d[i], 1e-12) << i;
+    EXPECT_NEAR(ur->model.joints[i].dh.alpha_rad, alpha[i], 1e-12) << i;
+    EXPECT_NEAR(ur->model.joints[i].dh.theta_rad, 0.0, 1e-12) << i;
+  }
+  EXPECT_LE(difference(ur->tool, {}), 1e-12);
+}
+
+TEST(UrClosedForm, TheUr5eUrdfGetsAllEightSolutionsEachRoundTripping) {
+  const kin::RobotModel model = kin::load_urdf(kRobots / "ur5e.urdf");
+  const auto k = kin::make_kinematics(model);
+  ASSERT_NE(dynamic_cast<const kin::PlacedKinematics*>(k.get()), nullptr)
+      << "the UR structure was not recognised";
+  EXPECT_EQ(k->configuration_names().size(), 8u);
+  std::mt19937_64 rng(5);
+  int original_found = 0;
+  std::array<int, 9> counts{};
+  double worst = 0.0;
+  const int n = 10'000;
+  for (int t = 0; t < n; ++t) {
+    const kin::JointVector q = random_within_limits(model, rng);
+    const math::Transform T = k->forward(q);
+    const kin::IkSolutions all = k->inverse_all(T);
+    ++counts[all.count];
+    bool found = false;
+    for (const kin::IkResult& r : all.solutions()) {
+      worst = std::max(worst, difference(k->forward(r.q), T));
+      EXPECT_EQ(k->configuration_of(r.q), r.configuration);
+      bool same = true;
+      for (std::size_t i = 0; i < 6; ++i) {
+        same = same && std::abs(std::remainder(r.q[i] - q[i], 2 * math::kPi)) < 1e-6;
+      }
+      found = found || same;
+    }
+    if (found) ++original_found;
+  }
+  EXPECT_LE(worst, 1e-9);
+  EXPECT_GE(original_found, n - 1);  // q itself among them (up to whole turns)
+  std::printf("UR5e solutions per pose (0..8):");
+  for (const int c : counts) std::printf(" %d", c);
+  std::printf("\n");
+  EXPECT_GT(counts[8], n / 2);
+}
+
+TEST(UrClosedForm, NoSolutionIsMissingFromTheEight) {
+  // What a numeric solver finds from seeds all over the joint ranges must be among the closed
+  // form's solutions (up to whole turns): a configuration it reports out of reach has none.
+  const kin::RobotModel model = kin::load_urdf(kRobots / "ur5e.urdf");
+  const auto k = kin::make_kinematics(model);
+  const kin::DhKinematics numeric(model, {.max_iterations = 200,
+                                          .position_tolerance_m = 1e-12,
+                                          .orientation_tolerance_rad = 1e-12,
+                                          .damping = 1e-4,
+                                          .max_step_rad_or_m = 0.5,
+                                          .restarts = 0});
+  std::mt19937_64 rng(11);
+  int found = 0, matched = 0;
+  for (int t = 0; t < 300; ++t) {
+    const math::Transform T = k->forward(random_within_limits(model, rng));
+    const kin::IkSolutions all = k->inverse_all(T);
+    for (int s = 0; s < 16; ++s) {
+      const kin::IkResult r = numeric.inverse(
+          T, {.configuration = std::nullopt, .near = random_within_limits(model, rng)});
+      if (!r) continue;
+      ++found;
+      for (const kin::IkResult& c : all.solutions()) {
+        bool same = true;
+        for (std::size_t i = 0; i < 6; ++i) {
+          same = same && std::abs(std::remainder(r.q[i] - c.q[i], 2 * math::kPi)) < 1e-6;
+        }
+        if (same) {
+          ++matched;
+          break;
+        }
+      }
+    }
+  }
+  EXPECT_GT(found, 1000);
+  EXPECT_EQ(matched, found);
+}
+
+TEST(UrClosedForm, OutOfReachAndTheWristSingularitySaySo) {
+  const auto k = kin::make_kinematics(kin::load_urdf(kRobots / "ur5e.urdf"));
+  const math::Transform far{math::Rot3::rot_x(math::kPi), {1.5, 0.0, 0.3}};  // reach ~1.0 m
+  EXPECT_EQ(k->inverse(far).status, kin::IkStatus::out_of_reach);
+  EXPECT_EQ(k->inverse_all(far).count, 0u);
+  // theta5 = 0: z5 along z1, theta6 and the arm's sum one rotation; near's theta6 is kept.
+  const kin::JointVector q{0.3, -1.2, 1.1, -0.4, 0.0, 0.7};
+  const math::Transform T = k->forward(q);
+  const kin::IkResult r = k->inverse(T, {.configuration = k->configuration_of(q), .near = q});
+  ASSERT_TRUE(r) << kin::describe(r.status);
+  EXPECT_EQ(r.singularity, kin::Singularity::wrist);
+  EXPECT_LE(difference(k->forward(r.q), T), 1e-9);
+  EXPECT_NEAR(r.q[5], q[5], 1e-12);
+}
+
+TEST(UrClosedForm, ThePumaUrdfGetsThePumasClosedForm) {
+  const auto k = kin::make_kinematics(kin::load_urdf(kRobots / "puma560.urdf"));
+  ASSERT_NE(dynamic_cast<const kin::PlacedKinematics*>(k.get()), nullptr);
+  EXPECT_EQ(k->configuration_names().size(), 8u);
+  EXPECT_EQ(k->configuration_names()[0], "lun");
+}
+
+TEST(UrClosedForm, TheNumericSolverForcedOnTheUr5eFromItsReadyPose) {
+  const kin::RobotModel model = kin::load_urdf(kRobots / "ur5e.urdf");
+  const kin::DhKinematics numeric(model);
+  std::mt19937_64 rng(99);
+  int solved = 0;
+  const int n = 2'000;
+  for (int t = 0; t < n; ++t) {
+    const math::Transform T = numeric.forward(random_within_limits(model, rng));
+    const kin::IkResult r = numeric.inverse(T);
+    if (r) {
+      ++solved;
+      ASSERT_LE(difference(numeric.forward(r.q), T), 1e-9);
+    }
+  }
+  RecordProperty("solved_percent", std::to_string(100.0 * solved / n));
+  std::printf("numeric solver on the UR5e from the ready pose: %.2f %% of %d poses\n",
+              100.0 * solved / n, n);
+  EXPECT_GE(solved, n * 995 / 1000);
 }
 
 std::string error_of(const std::string& xml, const kin::UrdfOptions& options = {}) {

@@ -23,7 +23,7 @@ struct DhSolverSettings {
   double max_step_rad_or_m = 0.5;  ///< largest joint change per iteration
   /// Seeds spread over the joint ranges tried after the first seed fails (each up to
   /// max_iterations): an unreachable pose costs (1 + restarts) solves before it is refused.
-  int restarts = 8;
+  int restarts = 16;
 };
 
 class DhKinematics final : public Kinematics {

@@ -4,10 +4,12 @@
 #include <cstdint>
 #include <limits>
 
+#include "rccx/kinematics/dh_equivalent.hpp"
 #include "rccx/kinematics/dh_kinematics.hpp"
 #include "rccx/kinematics/dh_step.hpp"
 #include "rccx/kinematics/microbo_kinematics.hpp"
 #include "rccx/kinematics/puma_kinematics.hpp"
+#include "rccx/kinematics/ur_kinematics.hpp"
 #include "rccx/math/batch_trig.hpp"
 #include "rccx/math/units.hpp"
 
@@ -327,7 +329,49 @@ Jacobian Kinematics::jacobian_from_frames(const math::Transform* frames) const n
   return J;
 }
 
+namespace {
+
+/// A closed form for a general chain (a URDF's) whose DH table has a structure one serves (the
+/// UR family's, the PUMA's), checked against the chain at configurations spread over the joint
+/// ranges; nullptr when none fits (the numeric solver serves it).
+std::unique_ptr<Kinematics> closed_form_for_chain(const RobotModel& model) {
+  const std::optional<DhEquivalent> dh = dh_equivalent(model);
+  if (!dh) return nullptr;
+  std::unique_ptr<Kinematics> inner;
+  for (int kind = 0; kind < 2 && inner == nullptr; ++kind) {
+    try {
+      if (kind == 0) inner = std::make_unique<UrKinematics>(dh->model);
+      if (kind == 1) inner = std::make_unique<PumaKinematics>(dh->model);
+    } catch (const RobotFileError&) {  // not of that structure
+    }
+  }
+  if (inner == nullptr) return nullptr;
+  auto placed = std::make_unique<PlacedKinematics>(model, std::move(inner), dh->base, dh->tool);
+  const DhKinematics chain(model);
+  JointVector q(model.dof());
+  for (int k = 1; k <= 16; ++k) {
+    for (std::size_t i = 0; i < model.dof(); ++i) {
+      const Joint& j = model.joints[i];
+      const double lo = std::isfinite(j.lower) ? j.lower : -math::kPi;
+      const double hi = std::isfinite(j.upper) ? j.upper : math::kPi;
+      q[i] = lo + (hi - lo) * std::fmod(0.618033988749895 * static_cast<double>(k * (i + 3)), 1.0);
+    }
+    const auto a = placed->forward(q).rows();
+    const auto b = chain.forward(q).rows();
+    for (std::size_t e = 0; e < a.size(); ++e) {
+      if (!(std::abs(a[e] - b[e]) <= 1e-9)) return nullptr;
+    }
+  }
+  return placed;
+}
+
+}  // namespace
+
 std::unique_ptr<Kinematics> make_kinematics(const RobotModel& model) {
+  if (model.geometry == Geometry::chain) {
+    if (auto closed = closed_form_for_chain(model)) return closed;
+    return std::make_unique<DhKinematics>(model);
+  }
   switch (model.solver) {
     case SolverKind::microbo:
       return std::make_unique<MicroboKinematics>(model);
