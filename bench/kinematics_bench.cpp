@@ -446,11 +446,10 @@ void BM_Puma560IK(benchmark::State& state) {
   run_ik_one(state, puma(), puma_ik_pool());
 }
 
-void BM_Puma560IKAll(benchmark::State& state) {
-  static const std::string error = check_ik_all(puma(), puma_ik_pool());
+/// inverse_all over a pool, after its check; counts the solutions.
+void run_ik_all(benchmark::State& state, const Kinematics& k, const IkPool& pool,
+                const std::string& error) {
   if (!checked(state, error)) return;
-  const Kinematics& k = puma();
-  const IkPool& pool = puma_ik_pool();
   const std::size_t n = pool.pose.size();
   std::size_t i = 0;
   std::int64_t solutions = 0;
@@ -465,11 +464,15 @@ void BM_Puma560IKAll(benchmark::State& state) {
       benchmark::Counter(static_cast<double>(solutions), benchmark::Counter::kAvgIterations);
 }
 
-void BM_DhIK(benchmark::State& state) {
-  static const NumericCheck check = check_dh_ik(puma_ik_pool());
+void BM_Puma560IKAll(benchmark::State& state) {
+  static const std::string error = check_ik_all(puma(), puma_ik_pool());
+  run_ik_all(state, puma(), puma_ik_pool(), error);
+}
+
+/// The numeric solver over a pool from its seeds, after its check.
+void run_numeric_ik(benchmark::State& state, const rccx::kin::DhKinematics& dh, const IkPool& pool,
+                    const NumericCheck& check) {
   if (!checked(state, check.error)) return;
-  const rccx::kin::DhKinematics& dh = dh_puma();
-  const IkPool& pool = puma_ik_pool();
   const std::size_t n = pool.pose.size();
   std::size_t i = 0;
   std::int64_t ok = 0;
@@ -485,11 +488,10 @@ void BM_DhIK(benchmark::State& state) {
   state.counters["max_err"] = check.max_error;
 }
 
-void BM_KdlPuma560IK(benchmark::State& state) {
-  static const NumericCheck check = check_kdl_ik(puma_ik_pool());
+/// KDL's LMA over a pool from the same seeds, after its check.
+void run_kdl_ik(benchmark::State& state, KdlPuma& kdl, const IkPool& pool,
+                const NumericCheck& check) {
   if (!checked(state, check.error)) return;
-  KdlPuma& kdl = kdl_puma();
-  const IkPool& pool = puma_ik_pool();
   const std::size_t n = pool.pose.size();
   std::size_t i = 0;
   std::int64_t ok = 0, iterations = 0;
@@ -510,6 +512,16 @@ void BM_KdlPuma560IK(benchmark::State& state) {
   state.counters["max_err"] = check.max_error;
 }
 
+void BM_DhIK(benchmark::State& state) {
+  static const NumericCheck check = check_dh_ik(puma_ik_pool());
+  run_numeric_ik(state, dh_puma(), puma_ik_pool(), check);
+}
+
+void BM_KdlPuma560IK(benchmark::State& state) {
+  static const NumericCheck check = check_kdl_ik(puma_ik_pool());
+  run_kdl_ik(state, kdl_puma(), puma_ik_pool(), check);
+}
+
 // ---- the UR5e from its URDF (issue 26): closed form, numeric, KDL on the same poses ---------
 
 void BM_Ur5eIK(benchmark::State& state) {
@@ -520,59 +532,18 @@ void BM_Ur5eIK(benchmark::State& state) {
 
 void BM_Ur5eIKAll(benchmark::State& state) {
   static const std::string error = check_ik_all(ur5e(), ur5e_ik_pool());
-  if (!checked(state, error)) return;
-  const IkPool& pool = ur5e_ik_pool();
-  std::size_t i = 0;
-  std::int64_t solutions = 0;
-  for (auto _ : state) {
-    const auto all = ur5e().inverse_all(pool.pose[i]);
-    benchmark::DoNotOptimize(all);
-    solutions += static_cast<std::int64_t>(all.count);
-    if (++i == pool.pose.size()) i = 0;
-  }
-  pool_counters(state, pool);
-  state.counters["solutions"] =
-      benchmark::Counter(static_cast<double>(solutions), benchmark::Counter::kAvgIterations);
+  run_ik_all(state, ur5e(), ur5e_ik_pool(), error);
 }
 
 /// The numeric solver forced on the UR5e, from the seeds KDL gets (0.05 rad off each joint).
 void BM_Ur5eNumericIK(benchmark::State& state) {
   static const NumericCheck check = check_dh_ik(ur5e_ik_pool(), numeric_ur5e());
-  if (!checked(state, check.error)) return;
-  const IkPool& pool = ur5e_ik_pool();
-  std::size_t i = 0;
-  std::int64_t ok = 0;
-  for (auto _ : state) {
-    const IkResult r = numeric_ur5e().inverse(pool.pose[i], pool.seeded[i]);
-    benchmark::DoNotOptimize(r);
-    ok += r ? 1 : 0;
-    if (++i == pool.pose.size()) i = 0;
-  }
-  pool_counters(state, pool);
-  state.counters["ok_rate"] =
-      benchmark::Counter(static_cast<double>(ok), benchmark::Counter::kAvgIterations);
-  state.counters["max_err"] = check.max_error;
+  run_numeric_ik(state, numeric_ur5e(), ur5e_ik_pool(), check);
 }
 
 void BM_KdlUr5eIK(benchmark::State& state) {
   static const NumericCheck check = check_kdl_ik(ur5e_ik_pool(), kdl_ur5e(), ur5e());
-  if (!checked(state, check.error)) return;
-  KdlPuma& kdl = kdl_ur5e();
-  const IkPool& pool = ur5e_ik_pool();
-  std::size_t i = 0;
-  std::int64_t ok = 0;
-  KDL::JntArray q_out(kdl.chain.getNrOfJoints());
-  for (auto _ : state) {
-    const int rc = kdl.ik->CartToJnt(pool.kdl_seed[i], pool.kdl_pose[i], q_out);
-    benchmark::DoNotOptimize(rc);
-    benchmark::DoNotOptimize(q_out);
-    ok += rc >= 0 ? 1 : 0;
-    if (++i == pool.pose.size()) i = 0;
-  }
-  pool_counters(state, pool);
-  state.counters["ok_rate"] =
-      benchmark::Counter(static_cast<double>(ok), benchmark::Counter::kAvgIterations);
-  state.counters["max_err"] = check.max_error;
+  run_kdl_ik(state, kdl_ur5e(), ur5e_ik_pool(), check);
 }
 
 }  // namespace

@@ -102,6 +102,13 @@ int run_replay(const ViewArgs& a) {
 
 int run_robot(const ViewArgs& a) {
   const kin::RobotModel model = a.robot.model();
+  if (model.geometry != kin::Geometry::dh) {
+    // The page builds the arm from DH parameters; a general chain would be drawn wrong.
+    throw BadArgument{fmt::format(
+        "rccx view draws arms given by a DH table; {} is a URDF chain, which the view does not "
+        "draw yet (rccx kin and the rtc commands take it)",
+        model.name)};
+  }
   // Simulated time (deterministic, and no overrun on a busy machine), paced to the wall clock.
   rtc::SimulatedRobot robot(model);
   rccl::Manipulator arm(*robot.session);

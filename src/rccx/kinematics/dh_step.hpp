@@ -8,6 +8,7 @@
 
 #include <cmath>
 
+#include "rccx/kinematics/robot_model.hpp"
 #include "rccx/math/transform.hpp"
 
 namespace rccx::kin {
@@ -70,6 +71,39 @@ inline void rotate_about(math::Rot3& R, const math::Vec3& axis, int principal, d
       return;
     }
   }
+}
+
+/// One joint of a general chain (RobotModel's ChainStep) made ready for every sample: its unit
+/// axis, which coordinate axis that is, whether `after` is the identity.
+struct PreparedStep {
+  math::Transform origin;
+  math::Vec3 axis{0, 0, 1};
+  math::Transform after;
+  int principal = 3;  ///< principal_axis(axis)
+  bool after_identity = true;
+  bool prismatic = false;
+
+  PreparedStep() = default;
+  PreparedStep(const ChainStep& step, bool is_prismatic) noexcept
+      : origin(step.origin),
+        axis(step.axis.normalized()),
+        after(step.after),
+        principal(principal_axis(axis)),
+        after_identity(step.after.rows() == math::Transform{}.rows()),
+        prismatic(is_prismatic) {}
+};
+
+/// T <- T origin Motion(axis, q) after: one joint of a general chain, c and s the cosine and
+/// sine of q (unused for a prismatic joint).
+inline void apply_chain_step(math::Transform& T, const PreparedStep& step, double q, double c,
+                             double s) noexcept {
+  T = T * step.origin;
+  if (step.prismatic) {
+    T.p += T.R * (step.axis * q);
+  } else {
+    rotate_about(T.R, step.axis, step.principal, c, s);
+  }
+  if (!step.after_identity) T = T * step.after;
 }
 
 }  // namespace rccx::kin

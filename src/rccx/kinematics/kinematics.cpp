@@ -1,5 +1,7 @@
 #include "rccx/kinematics/kinematics.hpp"
 
+#include <fmt/format.h>
+
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -87,14 +89,7 @@ Kinematics::Kinematics(RobotModel model) : model_(std::move(model)) {
   }
   general_ = model_.geometry == Geometry::chain;
   for (std::size_t i = 0; general_ && i < model_.dof(); ++i) {
-    const Joint& j = model_.joints[i];
-    Step& st = steps_[i];
-    st.origin = j.chain.origin;
-    st.axis = j.chain.axis.normalized();
-    st.after = j.chain.after;
-    st.after_identity = j.chain.after.rows() == math::Transform{}.rows();
-    st.prismatic = j.type == JointType::prismatic;
-    st.principal = principal_axis(st.axis);
+    steps_[i] = PreparedStep(model_.joints[i].chain, model_.joints[i].type == JointType::prismatic);
   }
   ready_ = model_.ready();
 }
@@ -258,29 +253,9 @@ math::Transform Kinematics::chain_forward(const JointVector& q,
                                           math::Transform* frames) const noexcept {
   // All the joint angles' sines and cosines first, four at a time.
   double theta[kMaxJoints] = {}, st[kMaxJoints], ct[kMaxJoints];
-  if (general_) {
-    for (std::size_t i = 0; i < dof(); ++i) theta[i] = steps_[i].prismatic ? 0.0 : q[i];
-    if (dof() > 4) {
-      math::sincos8(theta, st, ct);
-    } else {
-      math::sincos4(theta, st, ct);
-    }
-    math::Transform T;
-    for (std::size_t i = 0; i < dof(); ++i) {
-      const Step& s = steps_[i];
-      T = T * s.origin;
-      if (s.prismatic) {
-        T.p += T.R * (s.axis * q[i]);
-      } else {
-        rotate_about(T.R, s.axis, s.principal, ct[i], st[i]);
-      }
-      if (!s.after_identity) T = T * s.after;
-      if (frames != nullptr) frames[i] = T;
-    }
-    return T;
-  }
   for (std::size_t i = 0; i < dof(); ++i) {
-    theta[i] = links_[i].theta + (links_[i].prismatic ? 0.0 : q[i]);
+    theta[i] = general_ ? (steps_[i].prismatic ? 0.0 : q[i])
+                        : links_[i].theta + (links_[i].prismatic ? 0.0 : q[i]);
   }
   if (dof() > 4) {
     math::sincos8(theta, st, ct);
@@ -289,9 +264,12 @@ math::Transform Kinematics::chain_forward(const JointVector& q,
   }
   math::Transform T;
   for (std::size_t i = 0; i < dof(); ++i) {
-    const Link& l = links_[i];
-    const double d = l.d + (l.prismatic ? q[i] : 0.0);
-    apply_dh_link(T, ct[i], st[i], l.ca, l.sa, l.a, d);
+    if (general_) {
+      apply_chain_step(T, steps_[i], q[i], ct[i], st[i]);
+    } else {
+      const Link& l = links_[i];
+      apply_dh_link(T, ct[i], st[i], l.ca, l.sa, l.a, l.d + (l.prismatic ? q[i] : 0.0));
+    }
     if (frames != nullptr) frames[i] = T;
   }
   return T;
@@ -328,6 +306,33 @@ Jacobian Kinematics::jacobian_from_frames(const math::Transform* frames) const n
   }
   return J;
 }
+
+namespace detail {
+
+void require_dh_form(const RobotModel& m, std::string_view solver,
+                     const std::array<double, 6>& alpha_deg, const std::array<bool, 6>& a_allowed) {
+  auto fail = [&](const std::string& what) {
+    throw RobotFileError(fmt::format(
+        "robot \"{}\" asks for the {} closed form, but {}; use \"solver\": \"dh\" for a "
+        "different chain",
+        m.name, solver, what));
+  };
+  if (m.geometry != Geometry::dh) fail("its geometry is not a DH table");
+  if (m.dof() != 6) fail(fmt::format("it has {} joints, not 6", m.dof()));
+  for (std::size_t i = 0; i < 6; ++i) {
+    const Joint& j = m.joints[i];
+    if (j.type != JointType::revolute) fail(fmt::format("joint {} is not revolute", i + 1));
+    if (std::abs(j.dh.alpha_rad - math::deg_to_rad(alpha_deg[i])) > 1e-12) {
+      fail(fmt::format("joint {} has alpha {} deg, not {}", i + 1, math::rad_to_deg(j.dh.alpha_rad),
+                       alpha_deg[i]));
+    }
+    if (std::abs(j.dh.theta_rad) > 1e-12) fail(fmt::format("joint {} has a theta offset", i + 1));
+    if (!a_allowed[i] && std::abs(j.dh.a_m) > 1e-12)
+      fail(fmt::format("joint {} has a != 0", i + 1));
+  }
+}
+
+}  // namespace detail
 
 namespace {
 

@@ -18,6 +18,7 @@
 #include <span>
 #include <string_view>
 
+#include "rccx/kinematics/dh_step.hpp"
 #include "rccx/kinematics/joint_vector.hpp"
 #include "rccx/kinematics/robot_model.hpp"
 #include "rccx/math/transform.hpp"
@@ -156,16 +157,7 @@ class Kinematics {
   std::array<Link, kMaxJoints> links_{};
 
   /// Cached per-joint constants of a general chain (Geometry::chain): see ChainStep.
-  struct Step {
-    math::Transform origin;
-    math::Vec3 axis;
-    math::Transform after;
-    /// 0 any axis; 1, 2, 3: +x, +y, +z; -1, -2, -3: the negative ones (a cheaper rotation).
-    int principal = 0;
-    bool after_identity = true;
-    bool prismatic = false;
-  };
-  std::array<Step, kMaxJoints> steps_{};
+  std::array<PreparedStep, kMaxJoints> steps_{};
   /// The model is a general chain: chain_forward and jacobian_from_frames use steps_.
   bool general_ = false;
 
@@ -199,6 +191,14 @@ class AnalyticKinematics : public Kinematics {
   virtual IkStatus solve(const math::Transform& pose, Configuration which,
                          const JointVector& reference, IkResult& out) const noexcept = 0;
 };
+
+namespace detail {
+/// Throws RobotFileError unless `model` is a DH table of 6 revolute joints with these alphas
+/// (deg), no theta offsets and a != 0 only where `a_allowed`: the form a closed form (named
+/// `solver` in the message) is written for.
+void require_dh_form(const RobotModel& model, std::string_view solver,
+                     const std::array<double, 6>& alpha_deg, const std::array<bool, 6>& a_allowed);
+}  // namespace detail
 
 /// The solver the model asks for. Throws RobotFileError when the model's DH table does not have
 /// the structure its closed form needs.

@@ -20,14 +20,7 @@ DhChain::DhChain(const RobotModel& model) noexcept : dof(std::min(model.dof(), k
   }
   general = model.geometry == Geometry::chain;
   for (std::size_t i = 0; general && i < dof; ++i) {
-    const Joint& j = model.joints[i];
-    Step& s = steps[i];
-    s.origin = j.chain.origin;
-    s.axis = j.chain.axis.normalized();
-    s.after = j.chain.after;
-    s.principal = principal_axis(s.axis);
-    s.after_identity = j.chain.after.rows() == math::Transform{}.rows();
-    s.prismatic = j.type == JointType::prismatic;
+    steps[i] = PreparedStep(model.joints[i].chain, model.joints[i].type == JointType::prismatic);
   }
 }
 
@@ -47,14 +40,7 @@ void link_frames(const DhChain& chain, const JointVector& q, std::span<math::Tra
   math::Transform T = base;
   if (chain.general) {  // as Kinematics::chain_forward, from the base
     for (std::size_t i = 0; i < n; ++i) {
-      const DhChain::Step& s = chain.steps[i];
-      T = T * s.origin;
-      if (s.prismatic) {
-        T.p += T.R * (s.axis * q[i]);
-      } else {
-        rotate_about(T.R, s.axis, s.principal, ct[i], st[i]);
-      }
-      if (!s.after_identity) T = T * s.after;
+      apply_chain_step(T, chain.steps[i], q[i], ct[i], st[i]);
       out[i] = T;
     }
     return;

@@ -12,6 +12,7 @@
 #include <cstddef>
 #include <span>
 
+#include "rccx/kinematics/dh_step.hpp"
 #include "rccx/kinematics/joint_vector.hpp"
 #include "rccx/kinematics/robot_model.hpp"
 #include "rccx/math/transform.hpp"
@@ -32,15 +33,7 @@ struct DhChain {
   std::array<Link, kMaxJoints> links{};
   std::size_t dof = 0;  ///< at most kMaxJoints: joints past it are ignored
   /// A general chain's steps (Geometry::chain, a URDF's): used instead of `links` when set.
-  struct Step {
-    math::Transform origin;
-    math::Vec3 axis{0, 0, 1};
-    math::Transform after;
-    int principal = 3;  ///< principal_axis(axis)
-    bool after_identity = true;
-    bool prismatic = false;
-  };
-  std::array<Step, kMaxJoints> steps{};
+  std::array<PreparedStep, kMaxJoints> steps{};
   bool general = false;
 
   DhChain() = default;

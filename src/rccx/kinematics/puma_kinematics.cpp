@@ -28,19 +28,8 @@ PumaKinematics::PumaKinematics(RobotModel model) : AnalyticKinematics(std::move(
         "different chain",
         m.name, what));
   };
-  if (m.dof() != 6) fail(fmt::format("it has {} joints, not 6", m.dof()));
-  for (std::size_t i = 0; i < 6; ++i) {
-    const Joint& j = m.joints[i];
-    if (j.type != JointType::revolute) fail(fmt::format("joint {} is not revolute", i + 1));
-    if (std::abs(j.dh.alpha_rad - math::deg_to_rad(kAlphaDeg[i])) > 1e-12) {
-      fail(fmt::format("joint {} has alpha {} deg, not {}", i + 1, math::rad_to_deg(j.dh.alpha_rad),
-                       kAlphaDeg[i]));
-    }
-    if (std::abs(j.dh.theta_rad) > 1e-12) fail(fmt::format("joint {} has a theta offset", i + 1));
-    const bool a_allowed = i == 1 || i == 2;
-    if (!a_allowed && std::abs(j.dh.a_m) > 1e-12) fail(fmt::format("joint {} has a != 0", i + 1));
-    if (i == 4 && std::abs(j.dh.d_m) > 1e-12) fail("joint 5 has d != 0");
-  }
+  detail::require_dh_form(m, "PUMA", kAlphaDeg, {false, true, true, false, false, false});
+  if (std::abs(m.joints[4].dh.d_m) > 1e-12) fail("joint 5 has d != 0");
   d1_ = m.joints[0].dh.d_m;
   a2_ = m.joints[1].dh.a_m;
   d3_ = m.joints[1].dh.d_m + m.joints[2].dh.d_m;  // z1 and z2 are parallel: the offsets add

@@ -38,19 +38,7 @@ UrKinematics::UrKinematics(RobotModel model) : AnalyticKinematics(std::move(mode
         "different chain",
         m.name, what));
   };
-  if (m.geometry != Geometry::dh) fail("its geometry is not a DH table");
-  if (m.dof() != 6) fail(fmt::format("it has {} joints, not 6", m.dof()));
-  for (std::size_t i = 0; i < 6; ++i) {
-    const Joint& j = m.joints[i];
-    if (j.type != JointType::revolute) fail(fmt::format("joint {} is not revolute", i + 1));
-    if (std::abs(j.dh.alpha_rad - math::deg_to_rad(kAlphaDeg[i])) > 1e-12) {
-      fail(fmt::format("joint {} has alpha {} deg, not {}", i + 1, math::rad_to_deg(j.dh.alpha_rad),
-                       kAlphaDeg[i]));
-    }
-    if (std::abs(j.dh.theta_rad) > 1e-12) fail(fmt::format("joint {} has a theta offset", i + 1));
-    const bool a_allowed = i == 1 || i == 2;
-    if (!a_allowed && std::abs(j.dh.a_m) > 1e-12) fail(fmt::format("joint {} has a != 0", i + 1));
-  }
+  detail::require_dh_form(m, "UR", kAlphaDeg, {false, true, true, false, false, false});
   d1_ = m.joints[0].dh.d_m;
   a2_ = m.joints[1].dh.a_m;
   a3_ = m.joints[2].dh.a_m;
