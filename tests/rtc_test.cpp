@@ -3,12 +3,14 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <optional>
 #include <set>
@@ -20,6 +22,7 @@
 #include "rccx/hw/ideal_arm.hpp"
 #include "rccx/hw/simulated_arm.hpp"
 #include "rccx/kinematics/kinematics.hpp"
+#include "rccx/rtc/sample_log.hpp"
 #include "rccx/rtc/servo_driver.hpp"
 #include "rccx/rtc/session.hpp"
 #include "real_time_verdict.hpp"
@@ -707,6 +710,41 @@ std::vector<std::vector<double>> read_csv(const std::string& path, std::string& 
 }
 
 }  // namespace
+
+TEST(RtcLog, InSimulatedTimeARunFasterThanTheWriterLosesNoRow) {
+  // 20,000 rows pushed at once, five times the queue: in real time the rows past the queue are
+  // dropped (the loop never waits); in simulated time the loop waits for the writer and every
+  // row is in the file.
+  const kin::RobotModel model = kin::builtin_robot("puma560");
+  for (const bool simulated : {false, true}) {
+    const std::string path = ::testing::TempDir() + "rtc_log_fast.csv";
+    std::uint64_t dropped = 0, written = 0;
+    {
+      rtc::SampleLog log(path, model, rtc::LogHeader::of(model, "arm", 10ms, simulated));
+      rtc::LogRow row;
+      row.measured = model.ready();
+      row.commanded = model.ready();
+      for (int i = 0; i < 20'000; ++i) {
+        row.t_s = 0.01 * i;
+        (void)log.push(row, simulated);
+      }
+      (void)log.close();
+      dropped = log.rows_dropped();
+      written = log.rows_written();
+    }
+    if (simulated) {
+      EXPECT_EQ(dropped, 0U);
+      EXPECT_EQ(written, 20'000U);
+      std::ifstream in(path);
+      const auto lines =
+          std::count(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>(), '\n');
+      EXPECT_EQ(lines, 20'000 + 2);  // the header line, the column line, every row
+    } else {
+      EXPECT_GT(dropped, 0U) << "the real-time push waited for the writer";
+      EXPECT_EQ(dropped + written, 20'000U);
+    }
+  }
+}
 
 TEST(RtcLog, EveryControlledSampleIsARowWithTheCommandedToolPose) {
   const std::string path = ::testing::TempDir() + "rtc_log_test.csv";

@@ -281,7 +281,7 @@ void RobotChannel::log_sample() noexcept {
   row.segment = comm_.chg.segment;
   row.measured = h.q();
   row.commanded = comm_.targets.commanded(row.measured);
-  log->push(row);
+  log->push(row, simulated());  // simulated time waits for the writer: no row is lost
 }
 
 void RobotChannel::tap_sample() noexcept {

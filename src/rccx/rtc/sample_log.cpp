@@ -189,8 +189,13 @@ SampleLog::~SampleLog() {
   (void)close();
 }
 
-bool SampleLog::push(const LogRow& row) noexcept {
+bool SampleLog::push(const LogRow& row, bool wait_for_room) noexcept {
   if (queue_.push(row)) return true;
+  // The writer thread drains every 5 ms; it stops only at close(), after the loop has ended.
+  while (wait_for_room && !stop_.load(std::memory_order_relaxed)) {
+    std::this_thread::yield();
+    if (queue_.push(row)) return true;
+  }
   dropped_.fetch_add(1, std::memory_order_relaxed);
   return false;
 }

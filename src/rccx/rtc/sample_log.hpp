@@ -6,7 +6,8 @@
 // commanded tool position (m) and approach vector computed from the commanded joints by the
 // robot's forward kinematics. The communication task pushes fixed-size rows into a lock-free
 // queue; a writer thread does the kinematics and the file I/O, so the sample loop never waits
-// on a disk. Rows the writer cannot keep up with are dropped and counted, never blocked on.
+// on a disk. In real time, rows the writer cannot keep up with are dropped and counted, never
+// blocked on; in simulated time the loop waits for the writer instead (nothing is dropped).
 //
 // The file is written whole or not at all (rccx::io::AtomicFile): rows go to a temporary file
 // beside it, in whole rows, and close() renames it over the target. A write that fails (a full
@@ -112,8 +113,11 @@ class SampleLog {
   SampleLog(const SampleLog&) = delete;
   SampleLog& operator=(const SampleLog&) = delete;
 
-  /// Sample loop: queues a row; false (and counted) when the queue is full.
-  bool push(const LogRow& row) noexcept;
+  /// Sample loop: queues a row; false (and counted) when the queue is full. With
+  /// `wait_for_room` (simulated time, where no deadline waits on the loop) it yields until the
+  /// writer has made room instead: a fast simulated run is slowed to the writer's pace, its log
+  /// never loses a row.
+  bool push(const LogRow& row, bool wait_for_room = false) noexcept;
   [[nodiscard]] std::uint64_t rows_written() const noexcept { return written_.load(); }
   [[nodiscard]] std::uint64_t rows_dropped() const noexcept { return dropped_.load(); }
   [[nodiscard]] const std::filesystem::path& path() const noexcept { return path_; }
