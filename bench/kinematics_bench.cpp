@@ -63,6 +63,12 @@ const Kinematics& ur5e() {
       rccx::kin::make_kinematics(rccx::kin::load_urdf(RCCX_ROBOTS_DIR "/ur5e.urdf"));
   return *k;
 }
+/// The Panda from robots/panda.urdf: the 7-axis closed form given q7 (SevenAxisKinematics).
+const Kinematics& panda() {
+  static const std::unique_ptr<Kinematics> k =
+      rccx::kin::make_kinematics(rccx::kin::load_urdf(RCCX_ROBOTS_DIR "/panda.urdf"));
+  return *k;
+}
 const rccx::kin::DhKinematics& numeric_ur5e() {
   static const rccx::kin::DhKinematics k(ur5e().model());
   return k;
@@ -130,6 +136,10 @@ KdlPuma& kdl_puma() {
   static KdlPuma k(puma().model());
   return k;
 }
+KdlPuma& kdl_panda() {
+  static KdlPuma k(panda().model());
+  return k;
+}
 KdlPuma& kdl_ur5e() {
   static KdlPuma k(ur5e().model());
   return k;
@@ -176,6 +186,7 @@ struct IkPool {
 
 /// Near a singularity of the PUMA (wrist, elbow or shoulder) or of the Microbo (wrist).
 bool near_singular(const Kinematics& k, const JointVector& q) {
+  if (k.dof() == 7) return false;  // the Panda's solver fills free joints from `near`
   if (std::abs(std::sin(q[4])) < kNearSingular) return true;
   if (k.model().solver != rccx::kin::SolverKind::puma) return false;
   const auto& j = k.model().joints;
@@ -211,6 +222,7 @@ IkPool make_ik_pool(const Kinematics& k) {
     const Transform pose = k.forward(q);
     IkOptions one;
     one.configuration = k.configuration_of(q);
+    if (k.dof() == 7) one.redundant = q[6];  // the closed form given q7
     if (!k.inverse(pose, one)) {
       ++pool.skipped_unsolved;
       continue;
@@ -241,6 +253,10 @@ const IkPool& microbo_ik_pool() {
 }
 const IkPool& puma_ik_pool() {
   static const IkPool pool = make_ik_pool(puma());
+  return pool;
+}
+const IkPool& panda_ik_pool() {
+  static const IkPool pool = make_ik_pool(panda());
   return pool;
 }
 const IkPool& ur5e_ik_pool() {
@@ -488,6 +504,48 @@ void run_numeric_ik(benchmark::State& state, const rccx::kin::DhKinematics& dh, 
   state.counters["max_err"] = check.max_error;
 }
 
+/// Any solver's inverse() from the pool's seeds (or, `from_ready`, with no seed): how many it
+/// solves and its worst round-trip error.
+NumericCheck check_seeded_ik(const Kinematics& k, const IkPool& pool, bool from_ready = false) {
+  NumericCheck c;
+  if (!pool.error.empty()) {
+    c.error = pool.error;
+    return c;
+  }
+  std::size_t ok = 0;
+  for (std::size_t s = 0; s < pool.pose.size(); ++s) {
+    const IkResult r = k.inverse(pool.pose[s], from_ready ? IkOptions{} : pool.seeded[s]);
+    if (!r) continue;
+    ++ok;
+    c.max_error = std::max(c.max_error, max_diff(k.forward(r.q), pool.pose[s]));
+  }
+  c.ok_rate = static_cast<double>(ok) / static_cast<double>(pool.pose.size());
+  if (ok == 0) c.error = "the solver solved no sample";
+  if (c.max_error > kIkTolerance) {
+    c.error = "FK(IK(pose)) != pose, max element error " + std::to_string(c.max_error);
+  }
+  return c;
+}
+
+void run_seeded_ik(benchmark::State& state, const Kinematics& k, const IkPool& pool,
+                   const NumericCheck& check, bool from_ready = false) {
+  if (!checked(state, check.error)) return;
+  const std::size_t n = pool.pose.size();
+  const IkOptions ready;
+  std::size_t i = 0;
+  std::int64_t ok = 0;
+  for (auto _ : state) {
+    const IkResult r = k.inverse(pool.pose[i], from_ready ? ready : pool.seeded[i]);
+    benchmark::DoNotOptimize(r);
+    ok += r ? 1 : 0;
+    if (++i == n) i = 0;
+  }
+  pool_counters(state, pool);
+  state.counters["ok_rate"] =
+      benchmark::Counter(static_cast<double>(ok), benchmark::Counter::kAvgIterations);
+  state.counters["max_err"] = check.max_error;
+}
+
 /// KDL's LMA over a pool from the same seeds, after its check.
 void run_kdl_ik(benchmark::State& state, KdlPuma& kdl, const IkPool& pool,
                 const NumericCheck& check) {
@@ -546,6 +604,33 @@ void BM_KdlUr5eIK(benchmark::State& state) {
   run_kdl_ik(state, kdl_ur5e(), ur5e_ik_pool(), check);
 }
 
+// ---- the Panda from its URDF (issue 26): 7-axis closed form, KDL on the same poses ----------
+
+/// Given q7 and the configuration: the closed form alone.
+void BM_PandaIK(benchmark::State& state) {
+  static const std::string error = check_ik_one(panda(), panda_ik_pool());
+  if (!checked(state, error)) return;
+  run_ik_one(state, panda(), panda_ik_pool());
+}
+
+/// From the seeds KDL gets, q7 free: the solver starts at the seed's q7 and moves it only if it
+/// must, as the generator calls it every sample. This is the one compared with KDL's LMA.
+void BM_PandaIKSeeded(benchmark::State& state) {
+  static const NumericCheck check = check_seeded_ik(panda(), panda_ik_pool());
+  run_seeded_ik(state, panda(), panda_ik_pool(), check);
+}
+
+/// From the ready pose, q7 searched outward from ready's: the worst case of the search.
+void BM_PandaIKFromReady(benchmark::State& state) {
+  static const NumericCheck check = check_seeded_ik(panda(), panda_ik_pool(), true);
+  run_seeded_ik(state, panda(), panda_ik_pool(), check, true);
+}
+
+void BM_KdlPandaIK(benchmark::State& state) {
+  static const NumericCheck check = check_kdl_ik(panda_ik_pool(), kdl_panda(), panda());
+  run_kdl_ik(state, kdl_panda(), panda_ik_pool(), check);
+}
+
 }  // namespace
 
 BENCHMARK(BM_MicroboFK);
@@ -561,5 +646,9 @@ BENCHMARK(BM_Ur5eIK);
 BENCHMARK(BM_Ur5eIKAll);
 BENCHMARK(BM_Ur5eNumericIK);
 BENCHMARK(BM_KdlUr5eIK);
+BENCHMARK(BM_PandaIK);
+BENCHMARK(BM_PandaIKSeeded);
+BENCHMARK(BM_PandaIKFromReady);
+BENCHMARK(BM_KdlPandaIK);
 
 BENCHMARK_MAIN();

@@ -19,6 +19,7 @@
 
 #include "rccx/hw/rcu.hpp"
 #include "rccx/kinematics/kinematics.hpp"
+#include "rccx/kinematics/urdf.hpp"
 #include "rccx/math/units.hpp"
 
 #include "shell_run.hpp"
@@ -94,6 +95,29 @@ TEST(Cli, InverseRoundTripsEveryConfiguration) {
       "kin ik --robot puma560 --T " + T + " --near=0.3,-0.4,-0.4,2,0.4,-2.4 --json", false);
   ASSERT_EQ(near.exit_code, 0) << near.out;
   EXPECT_EQ(json::parse(near.out)["config"], "rdn");
+}
+
+TEST(Cli, ThePandaHoldsJoint7WhereToldAndRefusesItElsewhere) {
+  const std::string urdf = std::string(RCCX_ROBOTS_DIR) + "/panda.urdf";
+  const auto k = kin::make_kinematics(kin::load_urdf(urdf));
+  const kin::JointVector q{0.2, -0.4, 0.3, -2.0, 0.5, 1.9, -0.6};
+  const std::string T = pose_argument(k->forward(q));
+  const CliRun held = rccx_cli(
+      "kin ik --urdf " + urdf + " --T " + T + " --redundant -34.3774677 --deg --json", false);
+  ASSERT_EQ(held.exit_code, 0) << held.out;
+  const json j = json::parse(held.out);
+  kin::JointVector got(7);
+  for (std::size_t i = 0; i < 7; ++i) got[i] = j["q"][i].get<double>();
+  EXPECT_NEAR(got[6], -0.6, 1e-8);
+  EXPECT_LT(math::max_abs_difference(k->forward(got), k->forward(q)), 1e-10);
+  // Joint 7 outside its limits: unreachable (exit 3) with the reason; a 6-axis arm: exit 2.
+  const CliRun beyond = rccx_cli("kin ik --urdf " + urdf + " --T " + T + " --redundant 3.0");
+  EXPECT_EQ(beyond.exit_code, 3) << beyond.out;
+  EXPECT_NE(beyond.out.find("joint limits"), std::string::npos) << beyond.out;
+  const CliRun puma =
+      rccx_cli("kin ik --robot puma560 --xyz 0.4,0.1,0.3 --rpy 180deg,0,0 --redundant 0.5");
+  EXPECT_EQ(puma.exit_code, 2) << puma.out;
+  EXPECT_NE(puma.out.find("--redundant"), std::string::npos) << puma.out;
 }
 
 TEST(Cli, KinDefaultsToTheMicroboAsEveryCommand) {

@@ -9,9 +9,11 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <random>
 
 #include "rccl_harness.hpp"
+#include "rccx/kinematics/urdf.hpp"
 #include "rccx/math/units.hpp"
 #include "rccx/rccl/position.hpp"
 
@@ -283,6 +285,48 @@ TEST_P(Generator, GoalLeavingTheWorkspaceStopsTheArmSmoothly) {
 // A Cartesian line whose orientation turns the PUMA's wrist through theta5 = 0 while the wrist
 // configuration is kept: theta4 and theta6 would have to jump by pi there. It is found before
 // the arm moves, reported with the reason, and the arm stays.
+// The Panda from its URDF (7 axes, solved in closed form given q7): Cartesian lines keep the
+// tool on the line and q7 where it was, sample after sample, since the generator solves each
+// sample near the last; a joint move sets q7 anew and the next lines keep that one.
+TEST(GeneratorSevenAxes, CartesianLinesKeepQ7WhereItWasAndTheToolOnTheLine) {
+  GeneratorRun run(kin::load_urdf(std::filesystem::path(RCCX_ROBOTS_DIR) / "panda.urdf"));
+  ASSERT_EQ(run.model.dof(), 7u);
+  const kin::JointVector start{0.0, -0.3, 0.0, -2.2, 0.0, 2.0, 0.785};
+  const auto first = run.move(rccl::Position::joints("S", start), joint_settings());
+  ASSERT_TRUE(run.run_until_ended(first));
+  const math::Transform home = run.kinematics->forward(start);
+  const std::vector<math::Vec3> corners = {
+      home.p + math::Vec3{0, 0.15, 0}, home.p + math::Vec3{-0.1, 0.15, -0.15},
+      home.p + math::Vec3{-0.1, 0.05, -0.15}, home.p + math::Vec3{0, 0.05, 0}};
+  std::vector<std::uint64_t> ids;
+  for (const math::Vec3& c : corners) {
+    ids.push_back(run.move(pose_position("C", {home.R, c}), cartesian_settings(0.15)));
+  }
+  const std::size_t lines_from = run.qs.size();
+  ASSERT_TRUE(run.run_until_rest());
+  ASSERT_EQ(run.find_event(EventKind::failed), nullptr)
+      << run.find_event(EventKind::failed)->message();
+  for (std::size_t k = lines_from; k < run.qs.size(); ++k) {
+    ASSERT_EQ(run.qs[k][6], start[6]) << "q7 moved at t = " << run.t[k];
+  }
+  std::size_t judged = 0;
+  for (std::size_t i = 0; i < ids.size(); ++i) {
+    const math::Vec3 from = i == 0 ? home.p : corners[i - 1];
+    const double begin = i == 0 ? 0.0 : run.event_time(EventKind::ended, ids[i - 1]);
+    const double end = i + 1 < ids.size() ? run.event_time(EventKind::started, ids[i + 1]) : 1e9;
+    for (std::size_t k = lines_from; k < run.qs.size(); ++k) {
+      if (run.segment[k] != ids[i] || run.t[k] < begin || run.t[k] >= end) continue;
+      ++judged;
+      const math::Transform f = run.kinematics->forward(run.qs[k]);
+      ASSERT_LT(distance_to_line(f.p, from, corners[i]), 1e-4) << "t = " << run.t[k];
+      ASSERT_NEAR(dot(f.R.a, home.R.a), 1.0, 1e-10);
+    }
+  }
+  EXPECT_GT(judged, (run.qs.size() - lines_from) / 3);
+  expect_within_limits_and_speeds(run);
+  EXPECT_LE(worst_velocity_jump(run), 1.0 + 1e-3);
+}
+
 TEST(GeneratorSingularity, LineThroughTheWristSingularityIsReportedBeforeMoving) {
   GeneratorRun run("puma560");
   kin::JointVector qa = run.model.ready(), qb = run.model.ready();

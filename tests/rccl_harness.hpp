@@ -16,7 +16,9 @@ namespace rccx::test {
 
 struct GeneratorRun {
   explicit GeneratorRun(const std::string& robot, double period_s = 0.01)
-      : model(kin::builtin_robot(robot)),
+      : GeneratorRun(kin::builtin_robot(robot), period_s) {}
+  explicit GeneratorRun(kin::RobotModel robot, double period_s = 0.01)
+      : model(std::move(robot)),
         kinematics(kin::make_kinematics(model)),
         period(period_s),
         generator(*kinematics, rccl::GeneratorOptions{period_s, {}, {}}) {

@@ -21,6 +21,7 @@
 #include "rccx/kinematics/dh_kinematics.hpp"
 #include "rccx/kinematics/kinematics.hpp"
 #include "rccx/kinematics/link_frames.hpp"
+#include "rccx/kinematics/seven_axis_kinematics.hpp"
 #include "rccx/kinematics/ur_kinematics.hpp"
 #include "rccx/kinematics/urdf.hpp"
 #include "rccx/math/units.hpp"
@@ -67,6 +68,16 @@ double max_difference(const math::Transform& T, const KDL::Frame& F) {
     for (int c = 0; c < 3; ++c) worst = std::max(worst, std::abs(T.R(r, c) - F.M(r, c)));
   }
   return worst;
+}
+
+/// IkOptions in full (designated initializers must name every member to stay warning-free).
+kin::IkOptions ik(std::optional<kin::Configuration> configuration,
+                  std::optional<kin::JointVector> near, std::optional<double> redundant = {}) {
+  kin::IkOptions o;
+  o.configuration = configuration;
+  o.near = std::move(near);
+  o.redundant = redundant;
+  return o;
 }
 
 kin::JointVector random_within_limits(const kin::RobotModel& m, std::mt19937_64& rng) {
@@ -180,7 +191,7 @@ TEST(Urdf, TheNumericSolverRoundTripsTheImportedArms) {
       const math::Transform T = k->forward(q);
       kin::JointVector near = q;
       for (double& v : near) v += 0.05;  // a seed close by, as the generator gives one
-      const kin::IkResult r = k->inverse(T, {.configuration = std::nullopt, .near = near});
+      const kin::IkResult r = k->inverse(T, ik(std::nullopt, near));
       if (!r) continue;
       ++solved;
       const auto a = k->forward(r.q).rows();
@@ -336,8 +347,8 @@ TEST(UrClosedForm, NoSolutionIsMissingFromTheEight) {
     const math::Transform T = k->forward(random_within_limits(model, rng));
     const kin::IkSolutions all = k->inverse_all(T);
     for (int s = 0; s < 16; ++s) {
-      const kin::IkResult r = numeric.inverse(
-          T, {.configuration = std::nullopt, .near = random_within_limits(model, rng)});
+      const kin::IkResult r =
+          numeric.inverse(T, ik(std::nullopt, random_within_limits(model, rng)));
       if (!r) continue;
       ++found;
       for (const kin::IkResult& c : all.solutions()) {
@@ -364,7 +375,7 @@ TEST(UrClosedForm, OutOfReachAndTheWristSingularitySaySo) {
   // theta5 = 0: z5 along z1, theta6 and the arm's sum one rotation; near's theta6 is kept.
   const kin::JointVector q{0.3, -1.2, 1.1, -0.4, 0.0, 0.7};
   const math::Transform T = k->forward(q);
-  const kin::IkResult r = k->inverse(T, {.configuration = k->configuration_of(q), .near = q});
+  const kin::IkResult r = k->inverse(T, ik(k->configuration_of(q), q));
   ASSERT_TRUE(r) << kin::describe(r.status);
   EXPECT_EQ(r.singularity, kin::Singularity::wrist);
   EXPECT_LE(difference(k->forward(r.q), T), 1e-9);
@@ -396,6 +407,157 @@ TEST(UrClosedForm, TheNumericSolverForcedOnTheUr5eFromItsReadyPose) {
   std::printf("numeric solver on the UR5e from the ready pose: %.2f %% of %d poses\n",
               100.0 * solved / n, n);
   EXPECT_GE(solved, n * 995 / 1000);
+}
+
+bool same_angles(const kin::JointVector& a, const kin::JointVector& b, double tolerance) {
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    if (!(std::abs(std::remainder(a[i] - b[i], 2 * math::kPi)) < tolerance)) return false;
+  }
+  return true;
+}
+
+TEST(PandaClosedForm, GivenQ7EveryConfigurationRoundTripsAndTheArmsOwnIsAmongThem) {
+  const kin::RobotModel model = kin::load_urdf(kRobots / "panda.urdf");
+  const auto k = kin::make_kinematics(model);
+  ASSERT_NE(dynamic_cast<const kin::SevenAxisKinematics*>(k.get()), nullptr)
+      << "the Panda's structure was not recognised";
+  std::mt19937_64 rng(7);
+  double worst = 0.0;
+  int own = 0, consistent = 0, solutions = 0;
+  const int n = 10'000;
+  for (int t = 0; t < n; ++t) {
+    const kin::JointVector q = random_within_limits(model, rng);
+    const math::Transform T = k->forward(q);
+    const kin::IkSolutions all = k->inverse_all(T, ik(std::nullopt, q, q[6]));
+    bool found = false;
+    for (const kin::IkResult& r : all.solutions()) {
+      ++solutions;
+      worst = std::max(worst, difference(k->forward(r.q), T));
+      EXPECT_EQ(r.q[6], q[6]);  // q7 held where asked
+      if (k->configuration_of(r.q) == r.configuration) ++consistent;
+      found = found || same_angles(r.q, q, 1e-6);
+    }
+    if (found) ++own;
+  }
+  EXPECT_LE(worst, 1e-9);
+  EXPECT_GE(own, n - 1);
+  EXPECT_GE(consistent, solutions - 5);  // configuration_of names each solution's own branch
+  std::printf("Panda given q7: %.2f solutions within limits per pose, worst error %.2e\n",
+              static_cast<double>(solutions) / n, worst);
+}
+
+TEST(PandaClosedForm, NoSolutionGivenQ7IsMissing) {
+  // What a numeric solver finds with q7 locked, from seeds all over the ranges, must be among
+  // the closed form's solutions at that q7.
+  kin::RobotModel model = kin::load_urdf(kRobots / "panda.urdf");
+  const auto k = kin::make_kinematics(model);
+  std::mt19937_64 rng(13);
+  int found = 0, matched = 0;
+  for (int t = 0; t < 200; ++t) {
+    const kin::JointVector q = random_within_limits(model, rng);
+    const math::Transform T = k->forward(q);
+    kin::RobotModel locked = model;  // q7 fixed: the 6-joint chain with joint 7 in the tail
+    locked.joints.pop_back();
+    math::Transform tail = model.joints[6].chain.origin *
+                           math::Transform::rotation(model.joints[6].chain.axis, q[6]) *
+                           model.joints[6].chain.after;
+    locked.joints[5].chain.after = locked.joints[5].chain.after * tail;
+    const kin::DhKinematics numeric(locked, {.max_iterations = 200,
+                                             .position_tolerance_m = 1e-12,
+                                             .orientation_tolerance_rad = 1e-12,
+                                             .damping = 1e-4,
+                                             .max_step_rad_or_m = 0.5,
+                                             .restarts = 0});
+    const kin::IkSolutions all = k->inverse_all(T, ik(std::nullopt, q, q[6]));
+    for (int s = 0; s < 8; ++s) {
+      const kin::IkResult r =
+          numeric.inverse(T, ik(std::nullopt, random_within_limits(locked, rng)));
+      if (!r) continue;
+      ++found;
+      kin::JointVector r7(7);
+      for (std::size_t i = 0; i < 6; ++i) r7[i] = r.q[i];
+      r7[6] = q[6];
+      for (const kin::IkResult& c : all.solutions()) {
+        if (same_angles(r7, c.q, 1e-6)) {
+          ++matched;
+          break;
+        }
+      }
+    }
+  }
+  EXPECT_GT(found, 300);
+  EXPECT_EQ(matched, found);
+}
+
+TEST(PandaClosedForm, SolvesAtLeast999Of1000RandomReachablePosesWithinLimits) {
+  // From the ready pose, q7 free: the solver starts at ready's q7 and searches outward.
+  const kin::RobotModel model = kin::load_urdf(kRobots / "panda.urdf");
+  const auto k = kin::make_kinematics(model);
+  std::mt19937_64 rng(2026);
+  int solved = 0;
+  double worst = 0.0;
+  const int n = 10'000;
+  for (int t = 0; t < n; ++t) {
+    const math::Transform T = k->forward(random_within_limits(model, rng));
+    const kin::IkResult r = k->inverse(T);
+    if (!r) continue;
+    ++solved;
+    ASSERT_TRUE(model.within_limits(r.q)) << t;
+    worst = std::max(worst, difference(k->forward(r.q), T));
+  }
+  EXPECT_LE(worst, 1e-9);
+  RecordProperty("solved_percent", std::to_string(100.0 * solved / n));
+  std::printf("Panda from its ready pose, q7 searched: %.2f %% of %d poses\n", 100.0 * solved / n,
+              n);
+  EXPECT_GE(solved, n * 999 / 1000);
+}
+
+TEST(PandaClosedForm, Q7StaysPutWhereItCanAndMovesLittleWhereItMust) {
+  const kin::RobotModel model = kin::load_urdf(kRobots / "panda.urdf");
+  const auto k = kin::make_kinematics(model);
+  // A straight line of the flange, 1 mm a sample, solved from the last answer as the generator
+  // does. For 0.3 m q7 can stay where it started; further on, joint 7 held still would take the
+  // rest of the arm through a singularity of the other six (q5 -> 90 deg), and the solver moves
+  // q7 instead, a little each sample.
+  const kin::JointVector start{0.0, -0.3, 0.0, -2.2, 0.0, 2.0, 0.785};
+  const math::Transform from = k->forward(start);
+  kin::JointVector q = start;
+  double largest_q7_step = 0.0, largest_step = 0.0;
+  for (int i = 1; i <= 420; ++i) {
+    math::Transform T = from;
+    T.p.y += 0.001 * i;
+    const kin::IkResult r = k->inverse(T, ik(k->configuration_of(start), q));
+    ASSERT_TRUE(r) << "sample " << i << ": " << kin::describe(r.status);
+    ASSERT_LE(difference(k->forward(r.q), T), 1e-9);
+    largest_q7_step = std::max(largest_q7_step, std::abs(r.q[6] - q[6]));
+    for (std::size_t j = 0; j < 7; ++j) {
+      largest_step = std::max(largest_step, std::abs(r.q[j] - q[j]));
+    }
+    if (i == 300) {
+      EXPECT_EQ(largest_q7_step, 0.0) << "q7 moved where it need not";
+      EXPECT_LT(largest_step, 0.02) << "a joint jumped";
+    }
+    q = r.q;
+  }
+  EXPECT_GT(largest_q7_step, 0.0) << "the line was meant to reach where q7 must move";
+  EXPECT_LT(largest_q7_step, 0.01) << "q7 jumped";
+  EXPECT_GT(std::abs(q[6] - start[6]), 0.05);
+  // Asked for a q7 the pose cannot take within limits, the solver says so; free, it moves q7
+  // to the nearest that solves.
+  const math::Transform far = k->forward({0.0, 1.2, 0.0, -0.5, 0.0, 1.2, 0.0});
+  const kin::IkResult held = k->inverse(far, ik(std::nullopt, std::nullopt, 2.8));
+  const kin::IkResult free =
+      k->inverse(far, ik(std::nullopt, kin::JointVector{0.0, 1.2, 0.0, -0.5, 0.0, 1.2, 2.8}));
+  if (!held) {
+    ASSERT_TRUE(free);
+    EXPECT_LT(std::abs(free.q[6]), 2.8);
+  }
+  EXPECT_EQ(k->inverse(far, ik(std::nullopt, std::nullopt, 99.0)).status,
+            kin::IkStatus::joint_limits);
+  EXPECT_EQ(k->inverse(far, ik(std::nullopt, std::nullopt, std::nan(""))).status,
+            kin::IkStatus::bad_input);
+  const math::Transform out_of_reach{math::Rot3::identity(), {1.5, 0.0, 0.3}};
+  EXPECT_EQ(k->inverse(out_of_reach).status, kin::IkStatus::out_of_reach);
 }
 
 std::string error_of(const std::string& xml, const kin::UrdfOptions& options = {}) {

@@ -14,6 +14,7 @@
 #include "rccx/io/console.hpp"
 #include "rccx/io/parse.hpp"
 #include "rccx/kinematics/kinematics.hpp"
+#include "rccx/kinematics/seven_axis_kinematics.hpp"
 #include "rccx/math/units.hpp"
 #include "rccx/rccl/position_db.hpp"
 
@@ -124,6 +125,7 @@ struct IkArgs {
   PoseArgs pose;
   std::string config;
   std::string near;
+  std::optional<double> redundant;
   bool degrees = false;
   bool all = false;
   bool json = false;
@@ -161,6 +163,16 @@ int run_ik(const IkArgs& args) {
     }
     // The joints to stay near: a pose of the arm, so within its limits.
     options.near = joints_from(near, *k, args.degrees, "--near", true);
+  }
+
+  if (args.redundant) {
+    if (dynamic_cast<const kin::SevenAxisKinematics*>(k.get()) == nullptr) {
+      throw BadArgument{fmt::format(
+          "--redundant: robot {} is not a 7-axis arm solved given joint 7 (such as the Panda "
+          "from robots/panda.urdf); leave it out",
+          k->model().name)};
+    }
+    options.redundant = args.degrees ? math::deg_to_rad(*args.redundant) : *args.redundant;
   }
 
   const bool named = !k->configuration_names().empty();
@@ -305,8 +317,13 @@ void add_kin_command(CLI::App& app, int& exit_code) {
       "Comma-separated joint values (rad or m; with --deg, deg or m) to stay closest to; "
       "default: the robot's ready pose; within the joint limits");
   config_opt->excludes(near_opt);
+  ik_cmd->add_option("--redundant", ik->redundant,
+                     "A 7-axis arm solved given joint 7 (the Panda): hold joint 7 at this value "
+                     "(rad; with --deg, deg); without it, joint 7 starts from --near's (or the "
+                     "ready pose's) and moves only as far as it must");
   ik_cmd->add_flag("--all", ik->all, "Print every configuration's solution within limits");
-  ik_cmd->add_flag("--deg", ik->degrees, "--near is in degrees for revolute joints");
+  ik_cmd->add_flag("--deg", ik->degrees,
+                   "--near and --redundant are in degrees for revolute joints");
   ik_cmd->add_flag("--json", ik->json,
                    "Print {\"robot\":..,\"q\":[..],\"config\":..}, or with --all "
                    "{\"robot\":..,\"solutions\":[{\"config\":..,\"q\":[..]},...]}");

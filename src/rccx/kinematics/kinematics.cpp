@@ -11,6 +11,7 @@
 #include "rccx/kinematics/dh_step.hpp"
 #include "rccx/kinematics/microbo_kinematics.hpp"
 #include "rccx/kinematics/puma_kinematics.hpp"
+#include "rccx/kinematics/seven_axis_kinematics.hpp"
 #include "rccx/kinematics/ur_kinematics.hpp"
 #include "rccx/math/batch_trig.hpp"
 #include "rccx/math/units.hpp"
@@ -336,10 +337,48 @@ void require_dh_form(const RobotModel& m, std::string_view solver,
 
 namespace {
 
+/// Configurations spread over the joint ranges (a golden-ratio lattice), k = 1, 2, ...
+JointVector spread_configuration(const RobotModel& model, int k) {
+  JointVector q(model.dof());
+  for (std::size_t i = 0; i < model.dof(); ++i) {
+    const Joint& j = model.joints[i];
+    const double lo = std::isfinite(j.lower) ? j.lower : -math::kPi;
+    const double hi = std::isfinite(j.upper) ? j.upper : math::kPi;
+    q[i] = lo + (hi - lo) * std::fmod(0.618033988749895 * static_cast<double>(k * (i + 3)), 1.0);
+  }
+  return q;
+}
+
+/// The 7-axis closed form for a chain of its structure, checked on load: each of 16 spread
+/// configurations is among the solutions of its own pose at its own q7. nullptr when it does
+/// not fit.
+std::unique_ptr<Kinematics> seven_axis_for_chain(const RobotModel& model) {
+  std::unique_ptr<SevenAxisKinematics> k;
+  try {
+    k = std::make_unique<SevenAxisKinematics>(model);
+  } catch (const RobotFileError&) {  // not of that structure
+    return nullptr;
+  }
+  for (int n = 1; n <= 16; ++n) {
+    const JointVector q = spread_configuration(model, n);
+    IkOptions o;
+    o.near = q;
+    o.redundant = q[6];
+    o.configuration = k->configuration_of(q);
+    const IkResult r = k->inverse(k->forward(q), o);
+    if (!r) return nullptr;
+    for (std::size_t i = 0; i < q.size(); ++i) {
+      if (!(std::abs(r.q[i] - q[i]) <= 1e-7)) return nullptr;
+    }
+  }
+  return k;
+}
+
 /// A closed form for a general chain (a URDF's) whose DH table has a structure one serves (the
 /// UR family's, the PUMA's), checked against the chain at configurations spread over the joint
 /// ranges; nullptr when none fits (the numeric solver serves it).
 std::unique_ptr<Kinematics> closed_form_for_chain(const RobotModel& model) {
+  if (model.dof() == 7) return seven_axis_for_chain(model);
   const std::optional<DhEquivalent> dh = dh_equivalent(model);
   if (!dh) return nullptr;
   std::unique_ptr<Kinematics> inner;
@@ -355,12 +394,7 @@ std::unique_ptr<Kinematics> closed_form_for_chain(const RobotModel& model) {
   const DhKinematics chain(model);
   JointVector q(model.dof());
   for (int k = 1; k <= 16; ++k) {
-    for (std::size_t i = 0; i < model.dof(); ++i) {
-      const Joint& j = model.joints[i];
-      const double lo = std::isfinite(j.lower) ? j.lower : -math::kPi;
-      const double hi = std::isfinite(j.upper) ? j.upper : math::kPi;
-      q[i] = lo + (hi - lo) * std::fmod(0.618033988749895 * static_cast<double>(k * (i + 3)), 1.0);
-    }
+    q = spread_configuration(model, k);
     const auto a = placed->forward(q).rows();
     const auto b = chain.forward(q).rows();
     for (std::size_t e = 0; e < a.size(); ++e) {

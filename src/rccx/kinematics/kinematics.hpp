@@ -78,6 +78,10 @@ struct IkOptions {
   /// 2 pi turns of revolute joints with more than a turn of range, fill joints left free by a
   /// singularity, and seed the numeric solver. Defaults to the robot's ready pose.
   std::optional<JointVector> near;
+  /// The redundant joint's value (rad or m) for a solver that takes one: SevenAxisKinematics
+  /// holds joint 7 there. Without it such a solver keeps the value `near` has where it can.
+  /// Solvers of non-redundant arms ignore it.
+  std::optional<double> redundant;
 };
 
 /// The geometric Jacobian: rows vx vy vz (m/s) and wx wy wz (rad/s) of frame T6, both expressed
