@@ -310,14 +310,17 @@ Jacobian Kinematics::jacobian_from_frames(const math::Transform* frames) const n
 
 namespace detail {
 
+RobotFileError not_of_form(const RobotModel& model, std::string_view solver,
+                           std::string_view what) {
+  return RobotFileError(
+      fmt::format("robot \"{}\" asks for the {} closed form, but {}; use \"solver\": \"dh\" for a "
+                  "different chain",
+                  model.name, solver, what));
+}
+
 void require_dh_form(const RobotModel& m, std::string_view solver,
                      const std::array<double, 6>& alpha_deg, const std::array<bool, 6>& a_allowed) {
-  auto fail = [&](const std::string& what) {
-    throw RobotFileError(fmt::format(
-        "robot \"{}\" asks for the {} closed form, but {}; use \"solver\": \"dh\" for a "
-        "different chain",
-        m.name, solver, what));
-  };
+  auto fail = [&](const std::string& what) { throw not_of_form(m, solver, what); };
   if (m.geometry != Geometry::dh) fail("its geometry is not a DH table");
   if (m.dof() != 6) fail(fmt::format("it has {} joints, not 6", m.dof()));
   for (std::size_t i = 0; i < 6; ++i) {

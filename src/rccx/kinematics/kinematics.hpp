@@ -202,6 +202,8 @@ namespace detail {
 /// `solver` in the message) is written for.
 void require_dh_form(const RobotModel& model, std::string_view solver,
                      const std::array<double, 6>& alpha_deg, const std::array<bool, 6>& a_allowed);
+/// The RobotFileError a closed form (named `solver`) throws for a model not of its form.
+RobotFileError not_of_form(const RobotModel& model, std::string_view solver, std::string_view what);
 }  // namespace detail
 
 /// The solver the model asks for. Throws RobotFileError when the model's DH table does not have

@@ -22,12 +22,7 @@ constexpr std::array<double, 6> kAlphaDeg{90, 0, -90, 90, -90, 0};
 
 PumaKinematics::PumaKinematics(RobotModel model) : AnalyticKinematics(std::move(model)) {
   const RobotModel& m = this->model();
-  auto fail = [&](const std::string& what) {
-    throw RobotFileError(fmt::format(
-        "robot \"{}\" asks for the PUMA closed form, but {}; use \"solver\": \"dh\" for a "
-        "different chain",
-        m.name, what));
-  };
+  auto fail = [&](const std::string& what) { throw detail::not_of_form(m, "PUMA", what); };
   detail::require_dh_form(m, "PUMA", kAlphaDeg, {false, true, true, false, false, false});
   if (std::abs(m.joints[4].dh.d_m) > 1e-12) fail("joint 5 has d != 0");
   d1_ = m.joints[0].dh.d_m;

@@ -32,12 +32,7 @@ double wrap(double angle) {
 
 UrKinematics::UrKinematics(RobotModel model) : AnalyticKinematics(std::move(model)) {
   const RobotModel& m = this->model();
-  auto fail = [&](const std::string& what) {
-    throw RobotFileError(fmt::format(
-        "robot \"{}\" asks for the UR closed form, but {}; use \"solver\": \"dh\" for a "
-        "different chain",
-        m.name, what));
-  };
+  auto fail = [&](const std::string& what) { throw detail::not_of_form(m, "UR", what); };
   detail::require_dh_form(m, "UR", kAlphaDeg, {false, true, true, false, false, false});
   d1_ = m.joints[0].dh.d_m;
   a2_ = m.joints[1].dh.a_m;
