@@ -1,13 +1,13 @@
-# Writes a C++ source holding every robots/*.json as a string (run by the build, see
-# src/CMakeLists.txt). Inputs: ROBOTS_DIR, OUTPUT.
-file(GLOB robot_files RELATIVE "${ROBOTS_DIR}" "${ROBOTS_DIR}/*.json")
+# Writes a C++ source holding every robots/*.json, and every robots/*.urdf a robot file may name,
+# as a string (run by the build, see src/CMakeLists.txt). Inputs: ROBOTS_DIR, OUTPUT.
+file(GLOB robot_files RELATIVE "${ROBOTS_DIR}" "${ROBOTS_DIR}/*.json" "${ROBOTS_DIR}/*.urdf")
 list(SORT robot_files)
 set(body "")
 foreach(name IN LISTS robot_files)
   file(READ "${ROBOTS_DIR}/${name}" text)
   string(APPEND body "    {\"${name}\", R\"rccx_robot(${text})rccx_robot\"},\n")
 endforeach()
-file(WRITE "${OUTPUT}.tmp" "// Generated from robots/*.json by cmake/embed_robots.cmake; do not edit.
+file(WRITE "${OUTPUT}.tmp" "// Generated from robots/*.json and *.urdf by cmake/embed_robots.cmake; do not edit.
 #include \"rccx/kinematics/embedded_robots.hpp\"
 
 #include <array>

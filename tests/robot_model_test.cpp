@@ -24,7 +24,7 @@ TEST(BuiltinRobots, AreShippedAndConsistent) {
   for (const auto& name : names) {
     const kin::RobotModel model = kin::builtin_robot(name);
     EXPECT_EQ(model.name, name);
-    EXPECT_EQ(model.dof(), 6u);
+    EXPECT_EQ(model.dof(), name == "panda" ? 7u : 6u) << name;
     EXPECT_FALSE(model.source.empty());
     EXPECT_TRUE(model.within_limits(model.ready())) << name;
     EXPECT_NO_THROW((void)kin::make_kinematics(model)) << name;

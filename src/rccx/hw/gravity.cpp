@@ -1,12 +1,14 @@
 #include "rccx/hw/gravity.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "rccx/math/transform.hpp"
 
 namespace rccx::hw {
 
-GravityModel::GravityModel(const kin::RobotModel& model) noexcept : n_(model.dof()) {
+GravityModel::GravityModel(const kin::RobotModel& model) noexcept
+    : general_(model.geometry == kin::Geometry::chain), n_(std::min(model.dof(), kin::kMaxJoints)) {
   for (std::size_t i = 0; i < n_; ++i) {
     const kin::Joint& j = model.joints[i];
     links_[i] = {j.dh.a_m,
@@ -17,6 +19,7 @@ GravityModel::GravityModel(const kin::RobotModel& model) noexcept : n_(model.dof
                  j.type == kin::JointType::prismatic,
                  j.dynamics.link_mass_kg,
                  j.dynamics.link_com_m};
+    if (general_) steps_[i] = kin::PreparedStep(j.chain, j.type == kin::JointType::prismatic);
   }
 }
 
@@ -25,7 +28,18 @@ kin::JointVector GravityModel::load(const kin::JointVector& q) const noexcept {
   // Frame i-1's origin and z axis for each joint i, and each link's centre of mass, in the base.
   std::array<Vec3, kin::kMaxJoints> origin{}, axis{}, com{};
   math::Transform T = math::Transform::identity();
-  for (std::size_t i = 0; i < n_; ++i) {
+  for (std::size_t i = 0; i < n_ && general_; ++i) {
+    const kin::PreparedStep& step = steps_[i];
+    const math::Transform at = T * step.origin;  // the joint's frame before its motion
+    origin[i] = at.p;
+    axis[i] = at.R * step.axis;
+    const double c = step.prismatic ? 1.0 : std::cos(q[i]);
+    const double s = step.prismatic ? 0.0 : std::sin(q[i]);
+    kin::apply_chain_step(T, step, q[i], c, s);
+    const Link& l = links_[i];
+    com[i] = T * Vec3{l.com[0], l.com[1], l.com[2]};
+  }
+  for (std::size_t i = 0; i < n_ && !general_; ++i) {
     const Link& l = links_[i];
     origin[i] = T.p;
     axis[i] = T.R.a;

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <iterator>
@@ -36,6 +37,7 @@ std::array<JointPlant, kin::kMaxJoints> joint_plants(const kin::RobotModel& mode
     p.coulomb = pick(d.coulomb_friction, r ? r->coulomb_friction : 0.0, 0.0);
     p.max_effort = pick(d.max_effort, r ? r->max_effort : 0.0,
                         revolute ? kDefaultMaxEffort_N_m : kDefaultMaxEffort_N);
+    p.servo_inertia = p.inertia;
     // The vendor law's stiffness: motor parameter 1 is the dynamic zone's bandwidth, rad/s.
     p.bandwidth =
         r && r->motor_parameters[0] > 0 ? r->motor_parameters[0] : kDefaultServoBandwidth_rad_per_s;
@@ -95,6 +97,79 @@ math::Transform dh_constant(const kin::Joint& j) {
   if (std::abs(sa) < 1e-15) sa = 0.0;
   return {{{ct, st, 0.0}, {-st * ca, ct * ca, sa}, {st * sa, -ct * sa, ca}},
           {j.dh.a_m * ct, j.dh.a_m * st, j.dh.d_m}};
+}
+
+/// How link<i>'s body sits: in its parent body (link<i-1> or the base), where link i's own
+/// frame (DH frame i, or a chain's link frame i) and the next body's joint are in it, and the
+/// joint's axis in it. DH: the joint's motion, Rot(z, q) or Trans(z, q), commutes with the
+/// first two factors of the constant part C_i, so link<i> is frame i-1 moved and C_i places
+/// frame i. A chain: link<i> is frame i-1 times the joint's origin, moved about its axis; then
+/// `after` (the flange, on the last joint only) and the next joint's origin.
+struct BodyPlacement {
+  math::Transform in_parent;
+  math::Transform own;
+  math::Transform next;
+  math::Vec3 axis{0, 0, 1};
+};
+
+BodyPlacement placement(const kin::RobotModel& model, std::size_t i) {
+  const kin::Joint& j = model.joints[i];
+  BodyPlacement b;
+  if (model.geometry == kin::Geometry::chain) {
+    b.in_parent = i == 0 ? j.chain.origin : model.joints[i - 1].chain.after * j.chain.origin;
+    b.own = j.chain.after;
+    b.next = i + 1 < model.dof() ? j.chain.after * model.joints[i + 1].chain.origin : b.own;
+    b.axis = j.chain.axis.normalized();
+    return b;
+  }
+  b.in_parent = i == 0 ? math::Transform::identity() : dh_constant(model.joints[i - 1]);
+  b.own = dh_constant(j);
+  b.next = b.own;
+  return b;
+}
+
+/// The `<inertial>` of link i in its body: its mass at its centre of mass, and its tensor (the
+/// file's, turned from its own frame into the body's: R I R^T, given by its principal axes and
+/// moments) or, when the file gives none, a small sphere. Throws std::invalid_argument for a tensor
+/// no body can have.
+std::string link_inertial(const kin::RobotModel& model, std::size_t i, const math::Transform& own) {
+  const kin::JointDynamics& d = model.joints[i].dynamics;
+  const double mass = d.link_mass_kg > 0 ? d.link_mass_kg : kDefaultLinkMass_kg;
+  const math::Vec3 com = own * math::Vec3{d.link_com_m[0], d.link_com_m[1], d.link_com_m[2]};
+  const auto& t = d.link_inertia_kg_m2;
+  if (std::all_of(t.begin(), t.end(), [](double v) { return v == 0.0; })) {
+    const double gyr = 0.4 * mass * kLinkGyrationSphere_m * kLinkGyrationSphere_m;
+    return fmt::format(R"(<inertial pos="{}" mass="{}" diaginertia="{} {} {}"/>)", vec(com),
+                       num(mass), num(gyr), num(gyr), num(gyr));
+  }
+  Eigen::Matrix3d I, R;
+  I << t[0], t[3], t[4], t[3], t[1], t[5], t[4], t[5], t[2];
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) R(r, c) = own.R(r, c);
+  }
+  const Eigen::Matrix3d B = R * I * R.transpose();
+  // A body's principal moments are positive and each at most the sum of the other two.
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(B);
+  const Eigen::Vector3d e = solver.eigenvalues();
+  const double tolerance = 1e-9 * std::max(1.0, e.cwiseAbs().maxCoeff());
+  if (!(e.minCoeff() > 0.0) || e(0) + e(1) < e(2) - tolerance) {
+    throw std::invalid_argument(fmt::format(
+        "{}: joint {} ('{}'): the link's inertia tensor [{}] kg m^2 has principal moments {} {} "
+        "{}, which no body has (each must be > 0 and at most the sum of the other two): fix "
+        "the URDF's <inertia> or the robot file's \"link_inertia_kg_m2\", or give zeros",
+        model.name, i + 1, model.joints[i].name, fmt::join(t, " "), e(0), e(1), e(2)));
+  }
+  // The principal axes and moments, as MuJoCo keeps them: its own decomposition of a
+  // fullinertia is good to only ~1e-8 of the largest moment.
+  const Eigen::Matrix3d& V = solver.eigenvectors();
+  const double handed = V.determinant() > 0 ? 1.0 : -1.0;  // a rotation, not a reflection
+  const math::Rot3 axes{{V(0, 0), V(1, 0), V(2, 0)},
+                        {V(0, 1), V(1, 1), V(2, 1)},
+                        {handed * V(0, 2), handed * V(1, 2), handed * V(2, 2)}};
+  const auto q = quaternion(axes);
+  return fmt::format(R"(<inertial pos="{}" quat="{} {} {} {}" mass="{}" diaginertia="{} {} {}"/>)",
+                     vec(com), num(q[0]), num(q[1]), num(q[2]), num(q[3]), num(mass), num(e(0)),
+                     num(e(1)), num(e(2)));
 }
 
 bool usable_name(const std::string& s) {
@@ -211,7 +286,8 @@ std::string make_mjcf(const kin::RobotModel& model, const Scene& scene) {
   std::string x;
   x += fmt::format("<mujoco model=\"{}\">\n", model.name);
   x += "  <!-- generated by rccx::hw::make_mjcf from the robot file; SI units -->\n";
-  x += R"(  <compiler angle="radian" inertiafromgeom="false"/>)"
+  // balanceinertia: a thin rod's or plate's tensor may miss A + B >= C by rounding alone.
+  x += R"(  <compiler angle="radian" inertiafromgeom="false" balanceinertia="true"/>)"
        "\n";
   x += fmt::format(
       R"(  <option timestep="{}" gravity="0 0 {}" integrator="Euler" cone="pyramidal"/>)"
@@ -257,34 +333,27 @@ std::string make_mjcf(const kin::RobotModel& model, const Scene& scene) {
     const kin::Joint& j = model.joints[i];
     const bool revolute = j.type == kin::JointType::revolute;
     const JointPlant& p = plants[i];
-    const math::Transform C = dh_constant(j);
-    const math::Transform in_parent =
-        i == 0 ? math::Transform::identity() : dh_constant(model.joints[i - 1]);
+    const BodyPlacement b = placement(model, i);
     indent(x, depth);
-    x += fmt::format("<body name=\"link{}\" {}>\n", i + 1, pose(in_parent));
+    x += fmt::format("<body name=\"link{}\" {}>\n", i + 1, pose(b.in_parent));
     ++depth;
     const double margin = revolute ? kHardStopMargin_rad : kHardStopMargin_m;
     indent(x, depth);
     // Armature: the file's effective inertia (the motor reflected), so the servo's gains, set
     // from it, never meet a joint lighter than they assume.
     x += fmt::format(
-        R"(<joint name="j{}" type="{}" pos="0 0 0" axis="0 0 1" range="{} {}" armature="{}" damping="{}" frictionloss="{}"/>)"
+        R"(<joint name="j{}" type="{}" pos="0 0 0" axis="{}" range="{} {}" armature="{}" damping="{}" frictionloss="{}"/>)"
         "\n",
-        i + 1, revolute ? "hinge" : "slide", num(j.lower - margin), num(j.upper + margin),
-        num(p.inertia), num(p.viscous), num(p.coulomb));
-    // The link's mass at its centre of mass, given in DH frame i = this body x C.
-    const kin::JointDynamics& d = j.dynamics;
-    const double mass = d.link_mass_kg > 0 ? d.link_mass_kg : kDefaultLinkMass_kg;
-    const math::Vec3 com = C * math::Vec3{d.link_com_m[0], d.link_com_m[1], d.link_com_m[2]};
-    const double gyr = 0.4 * mass * kLinkGyrationSphere_m * kLinkGyrationSphere_m;
+        i + 1, revolute ? "hinge" : "slide", vec(b.axis), num(j.lower - margin),
+        num(j.upper + margin), num(p.inertia), num(p.viscous), num(p.coulomb));
+    // The link's mass and inertia, given in its own frame (DH frame i, or the chain's link
+    // frame i) = this body x b.own.
     indent(x, depth);
-    x += fmt::format(R"(<inertial pos="{}" mass="{}" diaginertia="{} {} {}"/>)"
-                     "\n",
-                     vec(com), num(mass), num(gyr), num(gyr), num(gyr));
-    // The link's shape: a capsule from this body's origin to frame i's (a prismatic link also
-    // reaches back along its axis by its lower limit, as a sliding rod does).
-    const math::Vec3 from{0.0, 0.0, revolute ? 0.0 : -std::max(0.0, j.lower)};
-    const math::Vec3 to = C.p;
+    x += link_inertial(model, i, b.own) + "\n";
+    // The link's shape: a capsule from this body's origin to the next joint's (a prismatic
+    // link also reaches back along its axis by its lower limit, as a sliding rod does).
+    const math::Vec3 from = b.axis * (revolute ? 0.0 : -std::max(0.0, j.lower));
+    const math::Vec3 to = b.next.p;
     indent(x, depth);
     if ((to - from).norm() < 1e-6) {
       x += fmt::format(
@@ -300,7 +369,7 @@ std::string make_mjcf(const kin::RobotModel& model, const Scene& scene) {
   }
   // T6, and the tool beyond the sensor: the sensor measures what the tool body exchanges with
   // the last link.
-  const math::Transform C6 = dh_constant(model.joints[n - 1]);
+  const math::Transform C6 = placement(model, n - 1).own;
   indent(x, depth);
   x += fmt::format("<site name=\"t6\" {} size=\"0.005\"/>\n", pose(C6));
   indent(x, depth);

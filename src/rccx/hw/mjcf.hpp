@@ -1,7 +1,7 @@
-// A robot file as a MuJoCo model (MJCF, the XML MuJoCo 2.2 loads): the arm's DH chain as a
-// chain of bodies, one joint each (hinge or slide, the file's limits widened to the hard stops),
-// masses and inertias where the file gives them, a motor per joint, a tool body beyond a
-// six-axis force/torque sensor at T6, and the cell's table and objects as boxes. What MujocoArm
+// A robot file as a MuJoCo model (MJCF, the XML MuJoCo 2.2 loads): the arm's DH chain or URDF
+// chain as a chain of bodies, one joint each (hinge or slide, the file's limits widened to the
+// hard stops), masses and inertias where the file gives them, a motor per joint, a tool body beyond
+// a six-axis force/torque sensor at T6, and the cell's table and objects as boxes. What MujocoArm
 // (mujoco_arm.hpp) loads; a person may load the same text in MuJoCo's viewer.
 //
 //   auto scene = std::make_shared<hw::Scene>(hw::scene_from_file(model));   // may be empty
@@ -15,8 +15,16 @@
 // Trans(x, a) Rot(x, alpha), is where link<i+1> (or the site "t6") sits in it (the joint's
 // motion commutes with the first two factors). So link<i>'s DH frame i is link<i> x C_i, the
 // file's centre of mass of link i is given there, and the site "t6" is T6 exactly (the FK test
-// compares it with Kinematics::forward at 1e-9). The robot's base is a body "base" placed at
-// Scene::base_m in the world; gravity is along world -z.
+// compares it with Kinematics::forward at 1e-9). A general chain (Geometry::chain, a URDF's):
+// link<i> is link frame i-1 times joint i's origin, its joint about (along) the joint's axis;
+// link<i+1> sits at `after` times the next origin, "t6" at the last joint's `after`, and the
+// link's mass, centre of mass and tensor are given in link frame i. The robot's base is a body
+// "base" placed at Scene::base_m in the world; gravity is along world -z.
+//
+// Inertia: each link's mass at its centre of mass, with its tensor (JointDynamics::
+// link_inertia_kg_m2, turned into the body's axes, as principal axes and moments) when the file
+// gives one, else a sphere of kLinkGyrationSphere_m; a link without mass weighs
+// kDefaultLinkMass_kg.
 //
 // Contact: the arm's and the tool's geoms touch the scene's boxes and never each other; boxes
 // touch each other. Stiff contact (solref 2 ms, critically damped; solimp 0.95 .. 0.99) and
@@ -71,6 +79,9 @@ struct JointPlant {
   double coulomb = 0.0;     ///< N m or N
   double max_effort = 0.0;  ///< N m or N
   double bandwidth = 0.0;   ///< the servo's closed-loop poles, rad/s
+  /// The inertia the servo's gains assume, kg m^2 or kg: `inertia` here; MujocoArm adds a URDF
+  /// chain's link inertia about the joint at the ready pose where the file gives no inertia.
+  double servo_inertia = 0.0;
 };
 
 /// Defaults for a joint the file says nothing about: a stiff servo, no friction.
@@ -83,8 +94,9 @@ inline constexpr double kDefaultMaxEffort_N = 1000.0;
 inline constexpr double kDefaultServoBandwidth_rad_per_s = 50.0;
 /// A link whose mass the file does not give weighs this much, kg.
 inline constexpr double kDefaultLinkMass_kg = 1.0;
-/// Links' inertia tensors are not in the robot files: each link is taken as a solid sphere of
-/// this radius about its centre of mass (the joints' armature, the motors' inertia, dominates).
+/// A link whose file gives no inertia tensor (a DH file without "link_inertia_kg_m2", a URDF
+/// without <inertia>) is taken as a solid sphere of this radius about its centre of mass (the
+/// joints' armature, the motors' inertia, dominates).
 inline constexpr double kLinkGyrationSphere_m = 0.05;
 /// The radius of the arm links' capsules, m.
 inline constexpr double kLinkRadius_m = 0.03;
@@ -113,7 +125,7 @@ Scene scene_from_file(const kin::RobotModel& model);
 /// The MJCF of `model` in `scene`. Names: bodies "base", "link1" .. "link<dof>", "tool", the
 /// boxes' names; joints "j1" ...; motors "m1" ...; sites "t6" (T6) and "ft" (the sensor, at T6
 /// on the tool body); sensors "ft_force" and "ft_torque". Throws std::invalid_argument for a
-/// box without a usable name or size, or substeps < 1.
+/// box without a usable name or size, substeps < 1, or a link inertia tensor no body has.
 std::string make_mjcf(const kin::RobotModel& model, const Scene& scene = {});
 
 }  // namespace rccx::hw

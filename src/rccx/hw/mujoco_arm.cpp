@@ -66,8 +66,11 @@ MujocoArm::MujocoArm(kin::RobotModel model, const SimulatedArmOptions& options)
       dof_[i] = m_->jnt_dofadr[j];
       actuator_[i] = id_of(mjOBJ_ACTUATOR, fmt::format("m{}", i + 1));
       arm_bodies_.push_back(id_of(mjOBJ_BODY, fmt::format("link{}", i + 1)));
+    }
+    assume_link_inertia();
+    for (std::size_t i = 0; i < n_; ++i) {
       const JointPlant& p = plants_[i];
-      gains_[i] = servo_gains(p.inertia, p.bandwidth);
+      gains_[i] = servo_gains(p.servo_inertia, p.bandwidth);
     }
     arm_bodies_.push_back(id_of(mjOBJ_BODY, "tool"));
     force_adr_ = m_->sensor_adr[id_of(mjOBJ_SENSOR, "ft_force")];
@@ -106,6 +109,24 @@ int MujocoArm::id_of(int type, std::string_view name) const {
                     type == mjOBJ_BODY ? "body" : (type == mjOBJ_SITE ? "site" : "element"), s));
   }
   return id;
+}
+
+void MujocoArm::assume_link_inertia() {
+  // A URDF gives its links' inertias but no motor's: where the robot file gives no effective
+  // inertia, the servo assumes the armature (the default motor) plus the links' inertia about
+  // the joint at the ready pose, as robots/puma560.json's inertias are made. With the armature
+  // alone an outstretched, loaded arm can be nine times heavier than the gains assume: at that
+  // ratio the three-pole servo stops damping (Routh: 3w x 3w^2 > r w^3 needs r < 9).
+  const kin::RobotModel& rm = model();
+  if (rm.geometry != kin::Geometry::chain) return;
+  const kin::JointVector ready = rm.ready();
+  for (std::size_t i = 0; i < n_; ++i) d_->qpos[qpos_[i]] = ready[i];
+  mj_forward(m_, d_);
+  for (std::size_t i = 0; i < n_; ++i) {
+    if (rm.joints[i].dynamics.inertia > 0) continue;
+    const int dof = dof_[i];
+    plants_[i].servo_inertia = d_->qM[m_->dof_Madr[dof]];  // armature + the links' M_ii
+  }
 }
 
 void MujocoArm::write_state() noexcept {
@@ -154,8 +175,8 @@ void MujocoArm::servo_tick(double dt) noexcept {
   compute_gravity_load(hold);
   for (std::size_t i = 0; i < n_; ++i) {
     const JointPlant& p = plants_[i];
-    tau_[i] = servo_effort(joints_[i], gains_[i], p.inertia, p.viscous, p.max_effort, hold[i], dt,
-                           integral_[i]);
+    tau_[i] = servo_effort(joints_[i], gains_[i], p.servo_inertia, p.viscous, p.max_effort, hold[i],
+                           dt, integral_[i]);
     d_->ctrl[actuator_[i]] = tau_[i];
     d_->qfrc_applied[dof_[i]] = joints_[i].external;
   }

@@ -9,7 +9,9 @@
 // e = setpoint - q, v_sp the setpoint's velocity, B the joint's viscous friction and g(q) the
 // gravity load of the arm and tool as MuJoCo models them (sum over the bodies of J_com^T m g,
 // not Coriolis). Kp = 3 I w^2, Kd = 3 I w, Ki = I w^3 with I and w from joint_plants() (the
-// file's dynamics, its RCU block, or defaults); the integrator runs only while |Kp e| is below
+// file's dynamics, its RCU block, or defaults; for a URDF chain's joint without the file's
+// inertia, I is the default armature plus the links' inertia about the joint at the ready pose,
+// MuJoCo's M_ii there: JointPlant::servo_inertia); the integrator runs only while |Kp e| is below
 // max_effort and the output is not saturated; the output is limited to max_effort and, along
 // the motion, on the motor's torque-speed line (zero at kOverspeedFactor x max_velocity). It
 // drives the joint's motor actuator (d->ctrl); external effort (set_external_effort) goes to
@@ -94,6 +96,8 @@ class MujocoArm final : public ArmBase {
   void servo_tick(double dt) noexcept override;
   void on_servo_restart(std::size_t j) noexcept override { integral_[j] = 0.0; }
   void compute_gravity_load(std::array<double, kin::kMaxJoints>& out) const noexcept;
+  /// A URDF chain's servo inertia where the file gives none (see above).
+  void assume_link_inertia();
   [[nodiscard]] int id_of(int type, std::string_view name) const;
   void write_state() noexcept;
 

@@ -41,7 +41,14 @@ struct JointDynamics {
   double coulomb_friction = 0.0;  ///< N m or N
   double max_effort = 0.0;        ///< motor torque (N m) or force (N) limit at the joint
   double link_mass_kg = 0.0;      ///< mass of the link this joint moves
-  std::array<double, 3> link_com_m{};  ///< that link's centre of mass in its own DH frame, m
+  std::array<double, 3> link_com_m{};  ///< that link's centre of mass in its own frame, m
+  /// That link's inertia tensor about its centre of mass, in the axes of its own frame, kg m^2:
+  /// ixx, iyy, izz, ixy, ixz, iyz, the tensor's elements as URDF, KDL and MuJoCo take them
+  /// (ixy = -integral of x y dm).
+  /// All zero: not given (the MuJoCo plant then takes a small sphere). "Its own frame" is DH
+  /// frame i for a DH model, link frame i (kin::link_frames) for a chain: for the last joint
+  /// of a URDF that is the flange's, where the fixed links out to it are lumped.
+  std::array<double, 6> link_inertia_kg_m2{};
 };
 
 /// A joint of a general serial chain, as a URDF gives it: the frame of link i is
@@ -115,12 +122,14 @@ class RobotFileError : public std::runtime_error {
 };
 
 /// Parses a robot description (JSON with // comments allowed; see robots/README.md).
-/// `origin` names the text in error messages.
+/// `origin` names the text in error messages; a URDF the text names ("urdf") is read relative
+/// to origin's folder (the working directory when origin has none).
 RobotModel parse_robot(std::string_view json_text, std::string_view origin);
-/// Reads and parses a robot file.
+/// Reads and parses a robot file (a URDF it names relative to the file's folder).
 RobotModel load_robot_file(const std::filesystem::path& path);
 
-/// The robots shipped in robots/, compiled into the library.
+/// The robots shipped in robots/ (its *.json; the URDFs they name are compiled in with them),
+/// compiled into the library.
 std::vector<std::string> builtin_robot_names();
 /// A shipped robot by name; throws RobotFileError listing the known names when there is none.
 RobotModel builtin_robot(std::string_view name);

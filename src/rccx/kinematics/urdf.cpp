@@ -5,6 +5,7 @@
 
 #include <tinyxml.h>
 #include <urdf_parser/urdf_parser.h>
+#include <Eigen/Core>
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -24,6 +25,7 @@ namespace {
 /// attack, and the message says which.
 constexpr double kMaxOffset_m = 100.0;
 constexpr double kMaxMass_kg = 1e5;
+constexpr double kMaxInertia_kg_m2 = 1e5;
 constexpr double kMaxLimit = 1e3;  // rad or m
 
 /// urdfdom reports through console_bridge; its words go into our message, not to stderr.
@@ -63,6 +65,48 @@ bool finite(const math::Transform& T) {
     if (!std::isfinite(v)) return false;
   }
   return true;
+}
+
+/// The second moment of the bodies lumped into one moving link (their inertia about the
+/// gathering frame's origin, in its axes), and whether any body gave a tensor.
+struct SecondMoment {
+  Eigen::Matrix3d about_origin = Eigen::Matrix3d::Zero();
+  bool given = false;
+};
+
+Eigen::Matrix3d to_eigen(const math::Rot3& R) {
+  Eigen::Matrix3d M;
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) M(r, c) = R(r, c);
+  }
+  return M;
+}
+
+/// m (|c|^2 E - c c^T): a point mass's inertia about the origin (the parallel-axis term).
+Eigen::Matrix3d point_inertia(double m, const math::Vec3& c) {
+  const Eigen::Vector3d v(c.x, c.y, c.z);
+  return m * (v.squaredNorm() * Eigen::Matrix3d::Identity() - v * v.transpose());
+}
+
+/// Adds a body (mass m, tensor I about its centre of mass in the axes of `at`, the inertial
+/// frame placed in the gathering frame) to the second moment: R I R^T plus the parallel-axis
+/// term.
+void add_second_moment(SecondMoment& s, double m, const Eigen::Matrix3d& I,
+                       const math::Transform& at) {
+  const Eigen::Matrix3d R = to_eigen(at.R);
+  s.about_origin += R * I * R.transpose() + point_inertia(m, at.p);
+  s.given = s.given || !I.isZero();
+}
+
+/// The lumped link's tensor about its centre of mass `com` (in the gathering frame), turned
+/// into the axes of the link's own frame, `own` in the gathering frame: ixx iyy izz ixy ixz
+/// iyz, zeros when no body gave one.
+std::array<double, 6> inertia_about_com(const SecondMoment& s, double mass, const math::Vec3& com,
+                                        const math::Rot3& own) {
+  if (!s.given) return {};
+  const Eigen::Matrix3d R = to_eigen(own);
+  const Eigen::Matrix3d I = R.transpose() * (s.about_origin - point_inertia(mass, com)) * R;
+  return {I(0, 0), I(1, 1), I(2, 2), I(0, 1), I(0, 2), I(1, 2)};
 }
 
 class Reader {
@@ -225,9 +269,10 @@ class Reader {
     }
   }
 
-  /// The link's mass and centre of mass, placed by `where` into the moving link's frame.
+  /// The link's mass, centre of mass and inertia, placed by `where` into the moving link's
+  /// frame.
   void add_inertial(const urdf::Link& link, const math::Transform& where, double& mass,
-                    math::Vec3& moment) const {
+                    math::Vec3& moment, SecondMoment& second) const {
     if (link.inertial == nullptr) return;
     const double m = link.inertial->mass;
     if (!std::isfinite(m) || m < 0.0 || m > kMaxMass_kg) {
@@ -237,6 +282,19 @@ class Reader {
     check_transform(com, fmt::format("link '{}''s inertial origin", link.name));
     mass += m;
     moment += (where * com.p) * m;
+    add_second_moment(second, m, inertia_tensor(link), where * com);
+  }
+
+  /// The link's <inertia> as a matrix (about its centre of mass, in the inertial frame).
+  Eigen::Matrix3d inertia_tensor(const urdf::Link& link) const {
+    const urdf::Inertial& i = *link.inertial;
+    Eigen::Matrix3d I;
+    I << i.ixx, i.ixy, i.ixz, i.ixy, i.iyy, i.iyz, i.ixz, i.iyz, i.izz;
+    if (!I.allFinite() || I.cwiseAbs().maxCoeff() > kMaxInertia_kg_m2) {
+      fail(fmt::format("link '{}': an inertia element that is not finite or over {} kg m^2",
+                       link.name, kMaxInertia_kg_m2));
+    }
+    return I;
   }
 
   RobotModel build(const urdf::ModelInterface& model,
@@ -252,11 +310,16 @@ class Reader {
     math::Transform pending;
     double mass = 0.0;
     math::Vec3 moment;
-    const auto close_link = [&](Joint* j) {
+    SecondMoment second;
+    // `own`: the link's frame in the frame its bodies were gathered in (the last link's is the
+    // flange's).
+    const auto close_link = [&](Joint* j, const math::Transform& own) {
       if (j == nullptr) return;  // the base's own mass moves with nothing
       j->dynamics.link_mass_kg = mass;
-      const math::Vec3 com = mass > 0.0 ? moment / mass : math::Vec3{};
+      const math::Vec3 gathered = mass > 0.0 ? moment / mass : math::Vec3{};
+      const math::Vec3 com = mass > 0.0 ? own.inverse() * gathered : math::Vec3{};
       j->dynamics.link_com_m = {com.x, com.y, com.z};
+      j->dynamics.link_inertia_kg_m2 = inertia_about_com(second, mass, gathered, own.R);
     };
     for (std::size_t k = 1; k < chain.size(); ++k) {
       const urdf::Link& link = *chain[k];
@@ -272,7 +335,7 @@ class Reader {
       }
       if (uj.type == urdf::Joint::FIXED) {
         pending = pending * origin;
-        add_inertial(link, pending, mass, moment);
+        add_inertial(link, pending, mass, moment, second);
         continue;
       }
       if (uj.type != urdf::Joint::REVOLUTE && uj.type != urdf::Joint::CONTINUOUS &&
@@ -289,7 +352,7 @@ class Reader {
         fail(fmt::format("more than {} moving joints between '{}' and '{}'", kMaxJoints, base->name,
                          chain.back()->name));
       }
-      close_link(out.joints.empty() ? nullptr : &out.joints.back());
+      close_link(out.joints.empty() ? nullptr : &out.joints.back(), math::Transform{});
       Joint j;
       j.name = uj.name;
       j.type = uj.type == urdf::Joint::PRISMATIC ? JointType::prismatic : JointType::revolute;
@@ -333,17 +396,17 @@ class Reader {
       pending = math::Transform{};
       mass = 0.0;
       moment = {};
-      add_inertial(link, pending, mass, moment);
+      second = {};
+      add_inertial(link, pending, mass, moment, second);
     }
     if (out.joints.empty()) {
       fail(fmt::format("no moving joint between '{}' and '{}'", base->name, chain.back()->name));
     }
     // The fixed joints out to the tip: the flange, in the last joint's `after`. The last link's
-    // centre of mass was gathered in its own frame; T6 is the flange's.
+    // mass was gathered in its own frame; T6 is the flange's.
     Joint& last = out.joints.back();
     last.chain.after = pending;
-    if (mass > 0.0) moment = pending.inverse() * (moment / mass) * mass;
-    close_link(&last);
+    close_link(&last, pending);
     return out;
   }
 

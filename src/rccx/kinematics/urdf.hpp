@@ -12,7 +12,9 @@
 //   - continuous joints: revolute with no limits (Joint::continuous);
 //   - fixed joints: lumped, into the next joint's origin, or after the last joint into its
 //     `after` (the flange), their links' masses into the moving link that carries them;
-//   - each link's inertial: mass and centre of mass in the link frame (JointDynamics).
+//   - each link's inertial: mass, centre of mass and inertia tensor (about the centre of
+//     mass) in the link frame (JointDynamics), a fixed link's lumped into the moving link that
+//     carries it (parallel axes; the last link's in the flange's frame).
 // Refused with a RobotFileError naming the joint or link: floating and planar joints, mimic
 // joints, a tree with no chain to the tip, a branching tree with no tip named (the message lists
 // the leaves), non-finite or absurd numbers (a link over 100 m, a mass over 1e5 kg), more than
