@@ -87,7 +87,8 @@ constexpr const char* kGoodRobot = R"({
      "upper_deg": 90, "resolution_deg_per_count": 0.01, "ready_deg": 0,
      "max_velocity_deg_per_s": 90,
      "dynamics": {"inertia_kg_m2": 2, "viscous_N_m_s_per_rad": 3, "coulomb_N_m": 4,
-                  "max_effort_N_m": 50, "link_mass_kg": 6, "link_com_m": [-0.25, 0, 0.01]}},
+                  "max_effort_N_m": 50, "link_mass_kg": 6, "link_com_m": [-0.25, 0, 0.01],
+                  "link_inertia_kg_m2": [0.1, 0.2, 0.25, -0.01, 0.02, 0]}},
     {"name": "j2", "type": "prismatic", "a_m": 0, "alpha_deg": 0, "lower_m": 0, "upper_m": 0.2,
      "resolution_mm_per_count": 0.01, "ready_m": 0.1, "max_velocity_mm_per_s": 250}
   ]
@@ -125,6 +126,7 @@ TEST(RobotFile, ParsesWithUnitsConverted) {
   EXPECT_EQ(d.max_effort, 50.0);
   EXPECT_EQ(d.link_mass_kg, 6.0);
   EXPECT_EQ(d.link_com_m, (std::array<double, 3>{-0.25, 0.0, 0.01}));
+  EXPECT_EQ(d.link_inertia_kg_m2, (std::array<double, 6>{0.1, 0.2, 0.25, -0.01, 0.02, 0.0}));
   // No "dynamics": all zeros ("not given").
   EXPECT_EQ(m.joints[1].dynamics.inertia, 0.0);
   EXPECT_EQ(m.joints[1].dynamics.link_mass_kg, 0.0);
@@ -216,6 +218,11 @@ TEST(RobotFile, RefusesBadDynamics) {
                "joint 1: dynamics: \"link_com_m\" must be [x, y, z]");
   expect_error(replaced(kGoodRobot, "[-0.25, 0, 0.01]", "[-0.25, 0, \"z\"]"),
                "\"link_com_m\" must hold three finite numbers");
+  expect_error(replaced(kGoodRobot, "[0.1, 0.2, 0.25, -0.01, 0.02, 0]", "[0.1, 0.2, 0.25]"),
+               "joint 1: dynamics: \"link_inertia_kg_m2\" must be [ixx, iyy, izz, ixy, ixz, iyz]");
+  expect_error(
+      replaced(kGoodRobot, "[0.1, 0.2, 0.25, -0.01, 0.02, 0]", "[0.1, 0.2, 0.25, 0, 0, null]"),
+      "\"link_inertia_kg_m2\" must hold six finite numbers");
   expect_error(replaced(kGoodRobot, "\"dynamics\": {", "\"dynamics\": 3, \"x\": {"),
                "joint 1: dynamics: expected an object");
   expect_error(replaced(kGoodRobot, "\"max_velocity_mm_per_s\": 250",
