@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "rccx/cell/capsule.hpp"
+#include "rccx/cell/cell.hpp"
 #include "rccx/cell/cell_model.hpp"
 #include "rccx/cell/collision.hpp"
 #include "rccx/cell/robot_capsules.hpp"
@@ -285,6 +286,49 @@ TEST(UrdfCollision, TheArmsDistanceNeverExceedsThatOfPointsInsideThem) {
     if (d < 0) ++collisions;
   }
   EXPECT_GT(collisions, 0);  // the placement makes the arms meet in some configurations
+}
+
+TEST(UrdfCollision, EachLeverBoundsHowFarTheLinksItMovesReachFromItsAxis) {
+  // Cell::levers_m for a chain: every capsule surface point of frames j+1 .. n (the links and
+  // tool joint j moves) lies within lever[j] of joint j's axis, measured here from the link
+  // frames at random configurations.
+  const cell::CellModel c = cell::load_cell_file(RCCX_CELLS_DIR "/ur5e_panda.json");
+  std::mt19937 random(5);
+  for (cell::CellRobot r : c.robots) {
+    r.tool = Transform{Rot3::identity(), {0.02, 0.0, 0.15}};  // a tool, to be counted too
+    const kin::JointVector lever = cell::Cell::levers_m(r);
+    cell::RobotCapsules robot(r.model, r.link_radius_m, Transform::identity(),
+                              cell::Cell::shapes_of(r));
+    double tightest = INFINITY;
+    for (int trial = 0; trial < 300; ++trial) {
+      kin::JointVector q(r.model.dof());
+      for (std::size_t i = 0; i < q.size(); ++i) {
+        q[i] =
+            std::uniform_real_distribution<double>(std::max(r.model.joints[i].lower, -kPi),
+                                                   std::min(r.model.joints[i].upper, kPi))(random);
+      }
+      ASSERT_TRUE(robot.update(q));
+      std::array<Transform, kin::kMaxJoints> f{};
+      kin::link_frames(r.model, q, f);
+      for (std::size_t j = 0; j < r.model.dof(); ++j) {
+        const Transform joint =
+            (j == 0 ? Transform::identity() : f[j - 1]) * r.model.joints[j].chain.origin;
+        const Vec3 axis = joint.R * r.model.joints[j].chain.axis;
+        double far = 0.0;
+        for (std::size_t k = 0; k < robot.capsules().size(); ++k) {
+          if (robot.pieces()[k].frame < j + 1) continue;  // not moved by joint j
+          const cell::Capsule& cap = robot.capsules()[k];
+          for (const Vec3& p : {cap.p0_m, cap.p1_m}) {
+            const Vec3 d = p - joint.p;
+            far = std::max(far, (d - axis * math::dot(d, axis)).norm() + cap.radius_m);
+          }
+        }
+        ASSERT_LE(far, lever[j] + 1e-12) << r.name << " joint " << j + 1;
+        tightest = std::min(tightest, lever[j] - far);
+      }
+    }
+    EXPECT_GE(tightest, 0.0) << r.name;
+  }
 }
 
 }  // namespace
