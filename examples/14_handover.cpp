@@ -1,4 +1,4 @@
-// Example 14: a UR5e hands a bar to a Franka Panda (cells/handover.json). Both arms come from
+// Example 14: a UR5e hands a bar to a Franka Panda (cells/ur5e_panda.json). Both arms come from
 // their makers' descriptions (robots/ur5e.json and robots/panda.json over their URDFs, docs/
 // KINEMATICS.md "Robots from URDF"), each on the MuJoCo plant built from its URDF's inertias,
 // both on the cell's one clock in simulated time. The UR5e is solved in closed form (its 8
@@ -27,7 +27,7 @@
 // PANDA_GRIP^-1): how far apart the two hands hold the one bar. Exit 1 when a motion failed,
 // the collision check stopped the arms, or an arm held its pose worse than 0.5 mm; 2 for a bad
 // option.
-// Run: ./build/release/examples/14_handover [--cell cells/handover.json] [--speed 0.15]
+// Run: ./build/release/examples/14_handover [--cell cells/ur5e_panda.json] [--speed 0.15]
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
 
@@ -228,13 +228,13 @@ int run(cell::Cell& c, double speed_m_per_s) {
 
 int main(int argc, char** argv) {
   CLI::App app{
-      "A UR5e hands a bar to a Franka Panda (cells/handover.json), both from their URDFs on "
+      "A UR5e hands a bar to a Franka Panda (cells/ur5e_panda.json), both from their URDFs on "
       "MuJoCo plants, in simulated time; measures how well each arm holds its pose against "
       "gravity during the hand-over."};
   std::string cell_path;
   double speed = 0.15;
   app.add_option("--cell", cell_path,
-                 "the cell file (default: cells/handover.json under $RCCX_DATA_DIR, else the "
+                 "the cell file (default: cells/ur5e_panda.json under $RCCX_DATA_DIR, else the "
                  "installed share/rccx or the source tree)")
       ->check(CLI::ExistingFile);
   app.add_option("--speed", speed, "tool speed of every motion, m/s")
@@ -246,7 +246,7 @@ int main(int argc, char** argv) {
     return app.exit(e) == 0 ? 0 : 2;
   }
   try {
-    if (cell_path.empty()) cell_path = io::find_data_file("cells/handover.json").string();
+    if (cell_path.empty()) cell_path = io::find_data_file("cells/ur5e_panda.json").string();
   } catch (const io::DataFileError& e) {
     std::fprintf(stderr, "14_handover: %s, or give --cell FILE\n", e.what());
     return 2;

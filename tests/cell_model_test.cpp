@@ -4,8 +4,10 @@
 // computation, and `rccx cell show` works on good and bad files.
 #include <fmt/format.h>
 #include <gtest/gtest.h>
+
 #include <sys/wait.h>
 #include <unistd.h>
+#include <tuple>
 
 #include <array>
 #include <cstdio>
@@ -321,8 +323,16 @@ TEST(CellFile, BadFilesNameTheKey) {
        "\"period_multiple\" 9 makes its period 63 ms"},
       {[&](json& j) { robot(j, 1)["name"] = "a"; }, "robot names must be unique"},
       {[&](json& j) { robot(j, 0)["name"] = "pu ma"; }, "robot 1: \"name\""},
-      {[&](json& j) { robot(j, 0)["robot_file"] = "x.json"; }, "give \"robot\""},
-      {[&](json& j) { robot(j, 0).erase("robot"); }, "give \"robot\""},
+      {[&](json& j) { robot(j, 0)["robot_file"] = "x.json"; }, "give one of \"robot\""},
+      {[&](json& j) { robot(j, 0)["urdf"] = "x.urdf"; }, "give one of \"robot\""},
+      {[&](json& j) { robot(j, 0).erase("robot"); }, "give one of \"robot\""},
+      {[&](json& j) { robot(j, 0)["tip_link"] = "tool0"; },
+       "\"base_link\" and \"tip_link\" choose a URDF's chain: give them with \"urdf\""},
+      {[&](json& j) {
+         robot(j, 0).erase("robot");
+         robot(j, 0)["urdf"] = "r.urdf";
+       },
+       "\"urdf\" needs the cell to be read from a file"},
       {[&](json& j) { robot(j, 0)["robot"] = "puma600"; }, "\"robot\": no robot named"},
       {[&](json& j) {
          robot(j, 0).erase("robot");
@@ -489,6 +499,81 @@ TEST(CellFile, RobotFilesAreFoundBesideTheCell) {
   EXPECT_THROW((void)cell::load_cell_file(dir / "none.json"), cell::CellFileError);
   EXPECT_THROW((void)cell::load_cell_file(dir), cell::CellFileError);  // a directory
   fs::remove_all(dir);
+}
+
+TEST(CellFile, UrdfRobotsAreFoundBesideTheCellWithTheirChainAndCapsules) {
+  const fs::path dir = fs::temp_directory_path() / fmt::format("rccx-cell-urdf-{}", getpid());
+  fs::create_directories(dir / "robots");
+  // Two links 0.3 m and 0.2 m, a 0.1 m flange past the last joint; the first link has a
+  // collision cylinder, and a branch (the "camera") makes the tip a choice.
+  std::ofstream(dir / "robots" / "arm.urdf") << R"(<robot name="arm">
+    <link name="base"/>
+    <link name="l1"><collision><origin xyz="0 0 0.15"/>
+      <geometry><cylinder radius="0.04" length="0.3"/></geometry></collision></link>
+    <link name="l2"/><link name="flange"/><link name="camera"/>
+    <joint name="j1" type="revolute"><parent link="base"/><child link="l1"/>
+      <axis xyz="0 0 1"/><limit lower="-2" upper="2" velocity="1" effort="1"/></joint>
+    <joint name="j2" type="revolute"><parent link="l1"/><child link="l2"/><origin xyz="0 0 0.3"/>
+      <axis xyz="0 1 0"/><limit lower="-2" upper="2" velocity="1" effort="1"/></joint>
+    <joint name="f" type="fixed"><parent link="l2"/><child link="flange"/><origin xyz="0.2 0 0.1"/></joint>
+    <joint name="c" type="fixed"><parent link="l1"/><child link="camera"/><origin xyz="0.05 0 0"/></joint>
+  </robot>)";
+  json j = valid_cell();
+  j["robots"][0].erase("robot");
+  j["robots"][0].erase("link_radius_m");
+  j["robots"][0].erase("shapes");
+  j["robots"][0]["urdf"] = "robots/arm.urdf";
+  j["robots"][0]["tip_link"] = "flange";
+  std::ofstream(dir / "cell.json") << j.dump();
+  const cell::CellModel c = cell::load_cell_file(dir / "cell.json");
+  const cell::CellRobot& r = c.robots[0];
+  EXPECT_EQ(r.model.geometry, kin::Geometry::chain);
+  EXPECT_EQ(r.urdf_file, "robots/arm.urdf");
+  ASSERT_EQ(r.model.dof(), 2U);
+  EXPECT_TRUE(r.link_radius_m.empty());  // the URDF's capsule stands for the links
+  ASSERT_EQ(r.model.collision.capsules.size(), 1U);
+  // By hand: 0.3 m to joint 2, then |(0.2, 0, 0.1)| to the flange, plus the tool.
+  const double tool = r.tool ? r.tool->p.norm() : 0.0;
+  EXPECT_NEAR(cell::reach_m(r), 0.3 + std::hypot(0.2, 0.1) + tool, 1e-15);
+  // Bad input: a link not there, a missing file, each named after the robot's place.
+  for (const auto& [key, value, says] :
+       std::vector<std::tuple<std::string, std::string, std::string>>{
+           {"tip_link", "nope", "no link named 'nope'"},
+           {"urdf", "robots/gone.urdf", "gone.urdf"}}) {
+    json bad = j;
+    bad["robots"][0][key] = value;
+    std::ofstream(dir / "cell.json") << bad.dump();
+    try {
+      (void)cell::load_cell_file(dir / "cell.json");
+      ADD_FAILURE() << key << " " << value << " was accepted";
+    } catch (const cell::CellFileError& e) {
+      EXPECT_NE(std::string(e.what()).find("robot 1: \"urdf\""), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(says), std::string::npos) << e.what();
+    }
+  }
+  // Without the tip the tree branches: the reader lists the leaves.
+  json branching = j;
+  branching["robots"][0].erase("tip_link");
+  std::ofstream(dir / "cell.json") << branching.dump();
+  try {
+    (void)cell::load_cell_file(dir / "cell.json");
+    ADD_FAILURE() << "a branching URDF without a tip was accepted";
+  } catch (const cell::CellFileError& e) {
+    EXPECT_NE(std::string(e.what()).find("camera, flange"), std::string::npos) << e.what();
+  }
+  fs::remove_all(dir);
+}
+
+TEST(CellFile, TheShippedUr5eAndPandaCellReads) {
+  const cell::CellModel c = cell::load_cell_file(RCCX_CELLS_DIR "/ur5e_panda.json");
+  ASSERT_EQ(c.robots.size(), 2U);
+  for (const cell::CellRobot& r : c.robots) {
+    EXPECT_EQ(r.model.geometry, kin::Geometry::chain) << r.name;
+    EXPECT_FALSE(r.model.collision.capsules.empty()) << r.name;
+    EXPECT_TRUE(r.model.collision.mesh_links.empty()) << r.name;
+  }
+  EXPECT_EQ(c.robots[0].model.dof(), 6U);
+  EXPECT_EQ(c.robots[1].model.dof(), 7U);
 }
 
 // ---- cells built in code, and their geometry ----

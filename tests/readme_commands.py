@@ -94,6 +94,8 @@ TABLE = {
     "rccx db --db cell.db show --robot puma560 PICK": Expect(0, r"PICK"),
     "rccx view --robot puma560": Expect(130, ADDRESS, serve=True),
     "rccx view --cell cells/cvarl.json": Expect(130, ADDRESS, serve=True),
+    "rccx view --urdf robots/panda.urdf": Expect(130, ADDRESS, serve=True),
+    "rccx view --cell cells/ur5e_panda.json": Expect(130, ADDRESS, serve=True),
     "RCCX_LOG=run.csv build/release/examples/04_washer": Expect(0, WASHER),
     "rccx view --log run.csv": Expect(130, ADDRESS, serve=True),
     "rccx plot run.csv -o run.svg": Expect(0, r"^run\.csv: robot microbo .*, \d+ samples, [\d.]+ s, worst path error [\d.]+ mm .*-> run\.svg"),

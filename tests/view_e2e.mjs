@@ -12,7 +12,12 @@
 //      loaded afresh five times (the socket, the scene and the 3D set-up race at each load) ends
 //      "live" with both robots' uPlot plots holding points, each time;
 //   4. layout: at 1280 x 760 and at 800 x 600 the live, replay and cell pages fit the window (no
-//      scrollbar) with the 3D canvas inside the viewport.
+//      scrollbar) with the 3D canvas inside the viewport;
+//   5. URDF robots: `rccx view --urdf` of the UR5e and the Panda: every link frame the page
+//      computes at a known configuration is `rccx kin fk --urdf --tip-link` of that link
+//      (within 1e-9), and the URDF's collision capsules are drawn; the UR5e and Panda cell
+//      (cells/ur5e_panda.json): each robot's tool point as the page draws it is the server's
+//      (C++ forward kinematics, base and turn included) at that sample.
 // Screenshots go to ARTIFACT_DIR (view-live.png, view-replay.png, view-cell.png, and the
 // live and cell pages at 800 x 600: view-live-800x600.png, view-cell-800x600.png).
 //
@@ -329,6 +334,80 @@ try {
   await small.screenshot({ path: join(artifacts, 'view-cell-800x600.png') });
   await small.close();
   await stop(cell.proc);
+
+  // --- 5. URDF robots: the page's chain against the C++ forward kinematics ------------------
+  // rccx view --urdf: every link frame the page computes at a known configuration equals
+  // `rccx kin fk --urdf FILE --tip-link LINK` of the chain cut at that link (the C++ forward
+  // kinematics, base to that link), within 1e-9.
+  const here = dirname(fileURLToPath(import.meta.url));
+  const urdfs = [
+    { file: 'ur5e.urdf', name: 'ur5e', q: [0.1, -1.2, 1.0, -0.5, 0.7, 0.3],
+      tips: ['shoulder_link', 'upper_arm_link', 'forearm_link', 'wrist_1_link', 'wrist_2_link', 'tool0'] },
+    { file: 'panda.urdf', name: 'panda', q: [0.3, -0.4, 0.2, -2.0, 0.5, 1.9, -0.6],
+      tips: ['panda_link1', 'panda_link2', 'panda_link3', 'panda_link4', 'panda_link5', 'panda_link6', 'panda_link8'] },
+  ];
+  const fk = (file, tip, q) => new Promise((resolve, reject) => {
+    const p = spawn(rccx, ['kin', 'fk', '--urdf', file, '--tip-link', tip, '--json', '--', ...q.map(String)],
+      { stdio: ['ignore', 'pipe', 'pipe'] });
+    let out = '', err = '';
+    p.stdout.on('data', (d) => { out += d; });
+    p.stderr.on('data', (d) => { err += d; });
+    p.on('exit', (code) => (code === 0 ? resolve(JSON.parse(out).T) : reject(new Error(`rccx kin fk: ${err}`))));
+  });
+  for (const u of urdfs) {
+    const file = resolve(here, '..', 'robots', u.file);
+    const run = await start(['view', '--urdf', file, '--port', '0', '--seconds', '120']);
+    procs.push(run.proc);
+    const uerrors = [];
+    const upage = await openPage(browser, run.url, uerrors);
+    const frames = await upage.evaluate(([n, q]) => window.rccxView.framesAt(n, q), [u.name, u.q]);
+    let worst = 0;
+    for (let k = 0; k < u.tips.length; ++k) {
+      const T = await fk(file, u.tips[k], u.q.slice(0, k + 1));
+      const m = frames[k + 1];  // column-major; frames[0] is the base
+      for (let r = 0; r < 3; ++r) for (let c = 0; c < 4; ++c) worst = Math.max(worst, Math.abs(m[c * 4 + r] - T[r][c]));
+    }
+    check(frames.length === u.q.length + 2 && worst < 1e-9,
+      `rccx view --urdf ${u.file}: the page's ${u.q.length} link frames are the C++ forward kinematics' (within ${worst.toExponential(1)} m)`);
+    const scene = await (await fetch(`${run.url}api/scene`)).json();
+    const drawn = await upage.evaluate((n) => window.rccxView.capsuleCount(n), u.name);
+    check(scene.robots[0].capsules.length > 0 && drawn === scene.robots[0].capsules.length,
+      `${u.name}: the page draws its URDF's ${drawn} collision capsules`);
+    check(uerrors.length === 0, `no console error for ${u.file} (${uerrors.join('; ') || 'none'})`);
+    await upage.close();
+    check((await stop(run.proc)) === 130, `rccx view --urdf ${u.file} ends on Ctrl-C with 130`);
+  }
+
+  // rccx view --cell with URDF robots (cells/ur5e_panda.json): each robot's tool point, as the
+  // page computes it at the pose it draws, is the server's (base * forward(q) * tool, C++) for
+  // that sample, the Panda turned half a turn and placed 1 m away as the cell says.
+  const pairFile = resolve(here, '..', 'cells', 'ur5e_panda.json');
+  const pair = await start(['view', '--cell', pairFile, '--port', '0', '--seconds', '120']);
+  procs.push(pair.proc);
+  const perrors = [];
+  const ppage = await openPage(browser, pair.url, perrors);
+  await ppage.waitForFunction(() => window.rccxView.robots.every((r) => r.t !== null), null, { timeout: 30000 });
+  const pnames = (await (await fetch(`${pair.url}api/scene`)).json()).robots.map((r) => r.name);
+  check(pnames.join() === 'ur5e,panda', `the UR5e and Panda cell has both robots (${pnames.join(', ')})`);
+  for (const [i, name] of pnames.entries()) {
+    const { t, q, tool } = await ppage.evaluate(([i, n]) => {
+      const r = window.rccxView.robots[i];
+      const f = window.rccxView.framesAt(n, r.q);
+      const m = f[f.length - 1];
+      return { t: r.t, q: r.q, tool: [m[12], m[13], m[14]] };
+    }, [i, name]);
+    const at = await (await fetch(`${pair.url}api/state?robot=${name}&t=${t}`)).json();
+    const qdiff = Math.max(...q.map((v, k) => Math.abs(v - at.q[k])));
+    const pdiff = Math.max(...tool.map((v, k) => Math.abs(v - at.p[k])));
+    check(qdiff < 1e-12 && pdiff < 1e-9,
+      `${name}: the tool point the page draws is the server's at t ${t.toFixed(3)} s (within ${pdiff.toExponential(1)} m)`);
+  }
+  const counts = await ppage.evaluate((ns) => ns.map((n) => window.rccxView.capsuleCount(n)), pnames);
+  check(counts.every((c) => c > 0), `both robots' collision capsules are drawn (${counts.join(', ')})`);
+  await ppage.screenshot({ path: join(artifacts, 'view-ur5e-panda.png') });
+  check(perrors.length === 0, `no console error on the UR5e and Panda cell (${perrors.join('; ') || 'none'})`);
+  await ppage.close();
+  await stop(pair.proc);
 } catch (e) {
   console.log(`FAIL ${e.stack || e}`);
   failures++;

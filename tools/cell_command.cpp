@@ -85,6 +85,7 @@ int run_show(const ShowArgs& args) {
       json item{{"name", r.name},
                 {"robot", r.model.name},
                 {"robot_file", r.model_file.empty() ? json(nullptr) : json(r.model_file)},
+                {"urdf", r.urdf_file.empty() ? json(nullptr) : json(r.urdf_file)},
                 {"period_multiple", r.period_multiple},
                 {"period_ms", ms(c.period(i))},
                 {"base", pose_json(r.base)},
@@ -141,8 +142,11 @@ int run_show(const ShowArgs& args) {
   for (std::size_t i = 0; i < c.robots.size(); ++i) {
     const cell::CellRobot& r = c.robots[i];
     fmt::print("  {} - {}{}, period {:g} ms (x{}), reach {:.1f} mm\n    base: {}\n", r.name,
-               r.model.name, r.model_file.empty() ? "" : " (" + r.model_file + ")", ms(c.period(i)),
-               r.period_multiple, cell::reach_m(r) * 1e3, pose_text(r.base));
+               r.model.name,
+               !r.model_file.empty()  ? " (" + r.model_file + ")"
+               : !r.urdf_file.empty() ? " (" + r.urdf_file + ")"
+                                      : "",
+               ms(c.period(i)), r.period_multiple, cell::reach_m(r) * 1e3, pose_text(r.base));
     if (r.tool) fmt::print("    tool: {}\n", pose_text(*r.tool));
     // The collision model's shapes beyond the links (docs/CELL.md), and what it stands on.
     for (const cell::RobotShape& k : r.shapes) {

@@ -4,6 +4,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <memory>
@@ -65,7 +66,10 @@ std::vector<kin::JointVector> sweep(const kin::RobotModel& m, std::size_t from =
       const double span = j.upper - j.lower;
       const double step = j.type == kin::JointType::prismatic ? 0.15 * span : a;
       const double sign = (i % 2 == 0) ? 1.0 : -1.0;
-      q[i] = std::clamp(ready[i] + sign * step, j.lower + 0.05 * span, j.upper - 0.05 * span);
+      q[i] = ready[i] + sign * step;
+      // A continuous joint has no limits to keep away from (its span is infinite).
+      if (std::isfinite(span))
+        q[i] = std::clamp(q[i], j.lower + 0.05 * span, j.upper - 0.05 * span);
     }
     goals.push_back(q);
   }
@@ -102,13 +106,6 @@ int run_replay(const ViewArgs& a) {
 
 int run_robot(const ViewArgs& a) {
   const kin::RobotModel model = a.robot.model();
-  if (model.geometry != kin::Geometry::dh) {
-    // The page builds the arm from DH parameters; a general chain would be drawn wrong.
-    throw BadArgument{fmt::format(
-        "rccx view draws arms given by a DH table; {} is a URDF chain, which the view does not "
-        "draw yet (rccx kin and the rtc commands take it)",
-        model.name)};
-  }
   // Simulated time (deterministic, and no overrun on a busy machine), paced to the wall clock.
   rtc::SimulatedRobot robot(model);
   rccl::Manipulator arm(*robot.session);
@@ -214,7 +211,8 @@ void add_view_command(CLI::App& app, int& exit_code) {
   CLI::App* cmd = app.add_subcommand(
       "view",
       "Serve a read-only web page of a simulated robot (or a cell's robots) at work: the arm in "
-      "3D from its DH chain, the tool path, named frames, live joint, Cartesian and speed plots. "
+      "3D from its chain (DH or URDF), the tool path, named frames, live joint, Cartesian and "
+      "speed plots. "
       "With --log, replays a recorded run (--log of the control programs, RCCX_LOG) with a time "
       "slider. Listens on 127.0.0.1 only unless --address says otherwise; open the address it "
       "prints. Runs until Ctrl-C (or --seconds).");

@@ -1,4 +1,4 @@
-// The page `rccx view` serves: the robots in 3D (three.js), drawn from their DH chains, with the
+// The page `rccx view` serves: the robots in 3D (three.js), drawn from their chains (DH or URDF), with the
 // tool path traced, named frames (the cell's, and the goals of the positions the program moves
 // to, the running motion's marked), the cell's objects and capsules; live joint, Cartesian and
 // velocity plots (uPlot) of each robot, one robot's at a time (the selector above them); and, for
@@ -8,7 +8,8 @@
 // and time of the pose drawn, per robot, the goal each robot's running motion goes to, the
 // frames drawn, which robot's plots are shown, how many points they hold, plotData(name):
 // the last point of a robot's joint plot as uPlot holds it, back in rad / m, and
-// plotSeries(name): how many points its uPlot plots hold.
+// plotSeries(name): how many points its uPlot plots hold, framesAt(name, q): the world frames
+// the page computes for a robot at joint values q (base, links, tool), capsuleCount(name).
 import * as THREE from 'three';
 import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
 import { CSS2DRenderer, CSS2DObject } from 'three/examples/jsm/renderers/CSS2DRenderer.js';
@@ -28,6 +29,8 @@ const view = {
   frameNames: [],      // the frames drawn, "name" (the cell's) or "robot:name" (a goal)
   plotData: () => null,
   plotSeries: () => null,  // (name): the points in that robot's uPlot plots as drawn
+  framesAt: () => null,    // (name, q): the frames the page computes, RobotView.framesAt
+  capsuleCount: () => null,  // (name): how many collision capsules the page draws
 };
 window.rccxView = view;
 
@@ -73,24 +76,37 @@ function openLink() {
 openLink();
 showLink();
 
-// --- Kinematics: standard DH, as rccx::kin::link_frames ---------------------------------------
-function dhMatrix(j, q) {
-  const theta = j.theta + (j.prismatic ? 0 : q);
-  const d = j.d + (j.prismatic ? q : 0);
-  const ct = Math.cos(theta), st = Math.sin(theta);
-  const ca = Math.cos(j.alpha), sa = Math.sin(j.alpha);
-  return new THREE.Matrix4().set(
-    ct, -st * ca, st * sa, j.a * ct,
-    st, ct * ca, -ct * sa, j.a * st,
-    0, sa, ca, d,
-    0, 0, 0, 1);
+// --- Kinematics: one rule for DH and URDF chains, as rccx::kin::link_frames --------------------
+// The scene gives each joint as a general chain step (rccx::view::to_json): frame i = frame i-1
+// origin Motion(axis, q) after, a DH link being origin = I, axis z, after = Rz(theta) Tz(d)
+// Tx(a) Rx(alpha).
+function jointSteps(j) {
+  return {
+    origin: new THREE.Matrix4().fromArray(j.origin),
+    axis: new THREE.Vector3(...j.axis).normalize(),
+    after: new THREE.Matrix4().fromArray(j.after),
+    via: new THREE.Vector3(...j.via),
+  };
+}
+function motion(step, prismatic, q) {
+  return prismatic
+    ? new THREE.Matrix4().makeTranslation(step.axis.x * q, step.axis.y * q, step.axis.z * q)
+    : new THREE.Matrix4().makeRotationAxis(step.axis, q);
 }
 
-/// base, base A1, base A1 A2, ... (dof + 1 frames).
-function linkFrames(robot, q) {
+/// base, base L1, base L1 L2, ... (dof + 1 frames); with `bends`, also where each drawn link
+/// bends: the joint's origin and its `via` point (world).
+function linkFrames(robot, q, bends = null) {
   const frames = [robot.baseMatrix.clone()];
   for (let i = 0; i < robot.joints.length; ++i) {
-    frames.push(frames[i].clone().multiply(dhMatrix(robot.joints[i], q[i])));
+    const step = robot.steps[i];
+    const atJoint = frames[i].clone().multiply(step.origin);
+    const moved = atJoint.clone().multiply(motion(step, robot.joints[i].prismatic, q[i]));
+    if (bends) {
+      bends.push([new THREE.Vector3().setFromMatrixPosition(atJoint),
+        step.via.clone().applyMatrix4(moved)]);
+    }
+    frames.push(moved.multiply(step.after));
   }
   return frames;
 }
@@ -162,11 +178,13 @@ class RobotView {
     this.index = desc.index;
     this.goal = null;
     this.joints = desc.joints;
+    this.steps = desc.joints.map(jointSteps);
     this.baseMatrix = new THREE.Matrix4().fromArray(desc.base);
     this.toolMatrix = desc.tool ? new THREE.Matrix4().fromArray(desc.tool) : new THREE.Matrix4();
     this.radii = desc.radii || [];
     // The links' size sets the drawing's scale.
-    const reach = desc.joints.reduce((s, j) => s + Math.abs(j.a) + Math.abs(j.d), 0) || 0.5;
+    const offset = (m) => Math.hypot(m[12], m[13], m[14]);
+    const reach = desc.joints.reduce((s, j) => s + offset(j.origin) + offset(j.after), 0) || 0.5;
     this.thick = Math.max(0.008, reach * 0.02);
     const colour = colours[index % colours.length];
     const linkMat = new THREE.MeshStandardMaterial({ color: colour, metalness: 0.2, roughness: 0.6 });
@@ -176,12 +194,11 @@ class RobotView {
     this.group = new THREE.Group();
     scene.add(this.group);
     const cyl = new THREE.CylinderGeometry(1, 1, 1, 16);
-    this.links = [];   // per joint: the d part and the a part
-    this.capsules = [];
+    this.links = [];   // per joint: to the joint's origin, on to its via point, on to its frame
     this.jointMeshes = [];
     for (let i = 0; i < desc.joints.length; ++i) {
       const parts = [];
-      for (let k = 0; k < 2; ++k) {
+      for (let k = 0; k < 3; ++k) {
         const m = new THREE.Mesh(cyl, linkMat);
         m.scale.set(this.thick, 1, this.thick);
         this.group.add(m);
@@ -192,29 +209,16 @@ class RobotView {
       jm.scale.set(this.thick * 1.6, this.thick * 3, this.thick * 1.6);
       this.group.add(jm);
       this.jointMeshes.push(jm);
-      if (this.radii.length) {
-        const r = this.radii[Math.min(i, this.radii.length - 1)];
-        const caps = [];
-        for (let k = 0; k < 2; ++k) {
-          const c = new THREE.Mesh(cyl, capsuleMat);
-          c.scale.set(r, 1, r);
-          this.group.add(c);
-          caps.push(c);
-        }
-        const sphere = new THREE.Mesh(new THREE.SphereGeometry(r, 16, 12), capsuleMat);
-        this.group.add(sphere);
-        caps.push(sphere);
-        this.capsules.push(caps);
-      }
     }
-    // The collision model's shapes beyond the links (pedestal, flange, hand, tool): a capsule
-    // each, in its frame (0: the base, i: link i's, the last: T6).
-    this.shapes = (desc.shapes || []).map((k) => {
+    // The collision model as the cell checks it (rccx::cell::RobotCapsules): the links' capsules
+    // of the cell's radii, the robot's own (a URDF's <collision>), the shapes (pedestal, flange,
+    // hand, tool); each in its frame (0: the base, i: link i's, the last: T6).
+    this.capsules = (desc.capsules || []).map((k) => {
       const body = new THREE.Mesh(cyl, capsuleMat);
       body.scale.set(k.radius, 1, k.radius);
       const ends = [0, 1].map(() => new THREE.Mesh(new THREE.SphereGeometry(k.radius, 16, 12), capsuleMat));
       this.group.add(body, ...ends);
-      return { k, body, ends };
+      return { k, body, ends, from: new THREE.Vector3(...k.from), to: new THREE.Vector3(...k.to) };
     });
     const baseMesh = new THREE.Mesh(cyl, jointMat);
     baseMesh.scale.set(this.thick * 3, this.thick * 1.5, this.thick * 3);
@@ -246,34 +250,46 @@ class RobotView {
 
   /// Draws the arm at joint values q.
   pose(q) {
-    const f = linkFrames(this, q);
+    const bends = [];
+    const f = linkFrames(this, q, bends);
     const o = f.map((m) => new THREE.Vector3().setFromMatrixPosition(m));
     for (let i = 0; i < this.joints.length; ++i) {
-      // Link i+1: d along z_i, then a along x_(i+1) (as rccx::cell::RobotCapsules).
-      const z = new THREE.Vector3().setFromMatrixColumn(f[i], 2);
-      const d = this.joints[i].d + (this.joints[i].prismatic ? q[i] : 0);
-      const mid = o[i].clone().addScaledVector(z, d);
-      placeBetween(this.links[i][0], o[i], mid);
-      placeBetween(this.links[i][1], mid, o[i + 1]);
+      // Link i+1: to joint i+1's origin, on to its via point (a DH link's d part), on to its
+      // frame (the a part; a chain's flange offset).
+      const [at, via] = bends[i];
+      placeBetween(this.links[i][0], o[i], at);
+      placeBetween(this.links[i][1], at, via);
+      placeBetween(this.links[i][2], via, o[i + 1]);
       const jm = this.jointMeshes[i];
-      jm.position.copy(o[i]);
-      jm.quaternion.setFromUnitVectors(Y, z);
-      if (this.capsules.length) {
-        const [c0, c1, s] = this.capsules[i];
-        placeBetween(c0, o[i], mid);
-        placeBetween(c1, mid, o[i + 1]);
-        s.position.copy(o[i + 1]);
-      }
+      jm.position.copy(at);
+      const axis = this.steps[i].axis.clone().transformDirection(f[i].clone().multiply(this.steps[i].origin));
+      jm.quaternion.setFromUnitVectors(Y, axis);
     }
-    for (const { k, body, ends } of this.shapes) {
+    for (const { k, body, ends, from, to } of this.capsules) {
       const frame = f[Math.min(k.frame, f.length - 1)];
-      const p0 = new THREE.Vector3(...k.from).applyMatrix4(frame);
-      const p1 = new THREE.Vector3(...k.to).applyMatrix4(frame);
+      const p0 = from.clone().applyMatrix4(frame);
+      let p1;
+      if (k.motion === 'dh_prismatic') {  // the d part of a prismatic DH joint: d + q along z
+        const z = new THREE.Vector3().setFromMatrixColumn(frame, 2);
+        p1 = new THREE.Vector3().setFromMatrixPosition(frame).addScaledVector(z, this.joints[k.joint].d + q[k.joint]);
+      } else if (k.motion === 'chain_prismatic') {  // a chain's prismatic travel along its axis
+        p1 = p0.clone().add(to.clone().transformDirection(frame).multiplyScalar(q[k.joint] * to.length()));
+      } else {
+        p1 = to.clone().applyMatrix4(frame);
+      }
       placeBetween(body, p0, p1);
       ends[0].position.copy(p0);
       ends[1].position.copy(p1);
     }
     this.tool.matrix.copy(f[f.length - 1]).multiply(this.toolMatrix);
+  }
+
+  /// The world frames the page computes at q (base, link 1 .. n, the tool), 16 numbers each,
+  /// column-major: what the end-to-end test compares with the C++ forward kinematics.
+  framesAt(q) {
+    const f = linkFrames(this, q);
+    f.push(f[f.length - 1].clone().multiply(this.toolMatrix));
+    return f.map((m) => m.toArray());
   }
 
   addPathPoint(p) {
@@ -501,6 +517,9 @@ async function main() {
   }
   const robots = new Map();
   desc.robots.forEach((r, i) => robots.set(r.index, new RobotView(r, i)));
+  const byName = (name) => [...robots.values()].find((r) => r.name === name);
+  view.framesAt = (name, q) => byName(name)?.framesAt(q) ?? null;
+  view.capsuleCount = (name) => byName(name)?.capsules.length ?? null;
   // A goal's label names its robot when the page shows several.
   const robotNames = [];
   if (desc.robots.length > 1) for (const r of desc.robots) robotNames[r.index] = r.name;

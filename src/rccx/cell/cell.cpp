@@ -86,7 +86,8 @@ std::vector<RobotShape> Cell::shapes_of(const CellRobot& robot) {
   // A tool the file gives no shape for is a capsule to the tool point, as thick as the last
   // link: what is there is not known, so not thinner than the arm.
   if (robot.tool && !hand) {
-    const double r = robot.link_radius_m.empty() ? 0.0 : robot.link_radius_m.back();
+    const double r =
+        robot.link_radius_m.empty() ? own_flange_radius_m(robot.model) : robot.link_radius_m.back();
     out.push_back({"tool", robot.model.dof(), {0, 0, 0}, robot.tool->p, r, "T6 to the tool point"});
   }
   return out;
@@ -94,23 +95,59 @@ std::vector<RobotShape> Cell::shapes_of(const CellRobot& robot) {
 
 kin::JointVector Cell::levers_m(const CellRobot& robot) {
   const kin::RobotModel& m = robot.model;
-  kin::JointVector lever(m.dof());
-  // How far a shape fixed in frame f reaches from that frame's origin.
+  const std::size_t n = m.dof();
+  kin::JointVector lever(n);
+  const auto link_radius = [&](std::size_t j) {  // joint j's (0-based) link radius, or 0
+    if (robot.link_radius_m.empty()) return 0.0;
+    return robot.link_radius_m.size() == n ? robot.link_radius_m[j] : robot.link_radius_m.front();
+  };
+  // How far a shape, or a capsule of the model's own, fixed in frame f reaches from that
+  // frame's origin.
   std::array<double, kin::kMaxJoints + 1> reach{};
-  for (const RobotShape& s : shapes_of(robot)) {
-    if (s.frame == 0 || s.frame > m.dof()) continue;  // the base's shapes do not move
-    reach[s.frame] =
-        std::max(reach[s.frame], std::max(s.from_m.norm(), s.to_m.norm()) + s.radius_m);
+  const auto fixed_in = [&](std::size_t frame, const math::Vec3& from, const math::Vec3& to,
+                            double radius) {
+    if (frame > n) return;
+    reach[frame] = std::max(reach[frame], std::max(from.norm(), to.norm()) + radius);
+  };
+  for (const RobotShape& s : shapes_of(robot)) fixed_in(s.frame, s.from_m, s.to_m, s.radius_m);
+  for (const kin::LinkCapsule& c : m.collision.capsules) {
+    fixed_in(c.frame, c.from_m, c.to_m, c.radius_m);
+  }
+  if (m.geometry == kin::Geometry::chain) {
+    // Joint j+1's axis passes through its origin, |after| from frame j+1's origin (after is
+    // the identity but on the last joint). Every point fixed in frames j+1 .. n is within
+    // `beyond` of frame j+1's origin: what those frames carry, and the offsets out to them.
+    const auto travel = [&](const kin::Joint& k) {
+      return k.type == kin::JointType::prismatic ? std::max(std::abs(k.lower), std::abs(k.upper))
+                                                 : 0.0;
+    };
+    double beyond = 0.0;
+    for (std::size_t j = n; j-- > 0;) {
+      const kin::ChainStep& step = m.joints[j].chain;
+      // What frame j+1 carries: its shapes and capsules, the tool (T6), and the link pieces
+      // of the cell's radius that start at its origin (to the next joint, or the flange).
+      double carried = reach[j + 1];
+      if (j + 1 == n) {
+        carried = std::max(carried, step.after.p.norm() + link_radius(j));
+        if (robot.tool) carried = std::max(carried, robot.tool->p.norm() + link_radius(j));
+      } else {
+        const kin::Joint& next = m.joints[j + 1];
+        carried = std::max(carried, next.chain.origin.p.norm() + travel(next) + link_radius(j + 1));
+        beyond += next.chain.origin.p.norm() + travel(next) + next.chain.after.p.norm();
+      }
+      beyond = std::max(beyond, carried);
+      lever[j] = step.after.p.norm() + beyond;
+    }
+    return lever;
   }
   // Joint j's axis passes through frame j-1's origin, where link j begins: every point of the
   // links it moves is within their lengths of it, their capsules' surfaces a radius further.
   double beyond = robot.tool ? robot.tool->p.norm() : 0.0;
   double radius = 0.0;
-  for (std::size_t j = m.dof(); j-- > 0;) {
+  for (std::size_t j = n; j-- > 0;) {
     beyond = std::max(beyond, reach[j + 1]);  // the shapes of link j+1's frame
     const kin::Joint& k = m.joints[j];
-    const double r = robot.link_radius_m.size() == m.dof() ? robot.link_radius_m[j]
-                                                           : robot.link_radius_m.front();
+    const double r = link_radius(j);
     beyond += std::max(r - radius, 0.0);  // the widest capsule so far counts once
     radius = std::max(radius, r);
     beyond += std::abs(k.dh.a_m);
@@ -120,6 +157,15 @@ kin::JointVector Cell::levers_m(const CellRobot& robot) {
     lever[j] = beyond;
   }
   return lever;
+}
+
+double Cell::own_flange_radius_m(const kin::RobotModel& model) noexcept {
+  double in_t6 = 0.0, any = 0.0;
+  for (const kin::LinkCapsule& c : model.collision.capsules) {
+    any = std::max(any, c.radius_m);
+    if (c.frame == model.dof()) in_t6 = std::max(in_t6, c.radius_m);
+  }
+  return in_t6 > 0.0 ? in_t6 : any;
 }
 
 void Cell::check_clear_at_start() const {

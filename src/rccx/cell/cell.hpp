@@ -231,11 +231,17 @@ class Cell : public Workcell {
                           double period_s, const kin::JointVector& lever_m) noexcept;
   /// How far a point of the links joint j moves (or of their capsules) can be from its axis:
   /// the lengths of links j.. (|a| + |d|, a prismatic d at its farther end), the tool's offset,
-  /// the reach of the shapes those links carry and the largest capsule radius, m.
+  /// the reach of the shapes those links carry and the largest capsule radius, m. For a
+  /// general chain (a URDF's): the offsets from joint j's origin out to each later frame
+  /// (|origin|, |after|, a prismatic joint's farther limit) plus what that frame carries (its
+  /// shapes, the model's own capsules, the link capsules and the tool).
   static kin::JointVector levers_m(const CellRobot& robot);
   /// A robot's named capsules for the collision check: the cell file's shapes and, for a tool
-  /// without a shape in T6, a capsule from T6's origin to the tool's, the last link's radius.
+  /// without a shape in T6, a capsule from T6's origin to the tool's, the last link's radius
+  /// (for a robot with no link radii, its own capsules' in T6, or their largest).
   static std::vector<RobotShape> shapes_of(const CellRobot& robot);
+  /// The radius of a robot's own capsules in T6 (the largest), else of any of them; 0: none.
+  static double own_flange_radius_m(const kin::RobotModel& model) noexcept;
 
  private:
   struct Robot {

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <fmt/ranges.h>
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -14,6 +15,7 @@
 #include "rccx/io/json_reader.hpp"
 #include "rccx/io/parse.hpp"
 #include "rccx/kinematics/kinematics.hpp"
+#include "rccx/kinematics/urdf.hpp"
 #include "rccx/math/units.hpp"
 
 namespace rccx::cell {
@@ -165,7 +167,20 @@ void validate(const CellModel& cell, std::string_view origin) {
           r.period_multiple, ms_of(period), ms_of(cell.base_period), r.period_multiple,
           ms_of(kMinPeriod), ms_of(kMaxPeriod)));
     }
-    if (r.link_radius_m.size() != r.model.dof()) {
+    if (r.model.collision.capsules.size() > kin::kMaxCollisionCapsules) {
+      c.fail(fmt::format(
+          "its robot model has {} collision capsules (its URDF's <collision> elements, those "
+          "inside others dropped); at most {}: merge some",
+          r.model.collision.capsules.size(), kin::kMaxCollisionCapsules));
+    }
+    const bool own_capsules = !r.model.collision.capsules.empty();
+    if (r.link_radius_m.empty() && !own_capsules) {
+      c.fail(fmt::format(
+          "\"link_radius_m\" is missing; robot {} has no collision capsules of its own (give "
+          "one number for all its links, or one per joint)",
+          r.model.name));
+    }
+    if (!r.link_radius_m.empty() && r.link_radius_m.size() != r.model.dof()) {
       c.fail(fmt::format(
           "\"link_radius_m\" has {} values; robot {} has {} joints (give one number for all, "
           "or one per joint)",
@@ -324,28 +339,57 @@ CellRobot parse_robot(const json& j, const std::string& where,
   robot.name = r.string("name");
   const bool shipped = r.has("robot");
   const bool file = r.has("robot_file");
-  if (shipped == file) r.fail("give \"robot\" (a shipped robot) or \"robot_file\" (a path), one");
+  const bool urdf = r.has("urdf");
+  if (int{shipped} + int{file} + int{urdf} != 1) {
+    r.fail(
+        "give one of \"robot\" (a shipped robot), \"robot_file\" (a robot file's path) or "
+        "\"urdf\" (a URDF's path)");
+  }
+  if (!urdf && (r.has("base_link") || r.has("tip_link"))) {
+    r.fail("\"base_link\" and \"tip_link\" choose a URDF's chain: give them with \"urdf\"");
+  }
+  const char* key = shipped ? "robot" : file ? "robot_file" : "urdf";
   try {
     if (shipped) {
       robot.model = kin::builtin_robot(r.string("robot"));
     } else {
-      robot.model_file = r.string("robot_file");
-      if (robot.model_file.empty()) r.fail("\"robot_file\" is empty; name a robot file");
+      const std::string path = r.string(key);
+      if (path.empty()) r.fail(fmt::format("\"{}\" is empty; name a file", key));
       if (base_dir.empty()) {
-        r.fail("\"robot_file\" needs the cell to be read from a file; use \"robot\"");
+        r.fail(fmt::format("\"{}\" needs the cell to be read from a file; use \"robot\"", key));
       }
-      robot.model = kin::load_robot_file(base_dir / robot.model_file);
+      if (file) {
+        robot.model_file = path;
+        robot.model = kin::load_robot_file(base_dir / path);
+      } else {
+        robot.urdf_file = path;
+        kin::UrdfOptions links;
+        if (r.has("base_link")) links.base_link = r.string("base_link");
+        if (r.has("tip_link")) links.tip_link = r.string("tip_link");
+        robot.model = kin::load_urdf(base_dir / path, links);
+      }
     }
-    // The solver the model asks for must accept its DH table (a closed form checks at build).
+    // The solver the model asks for must accept its chain (a closed form checks at build).
     (void)kin::make_kinematics(robot.model);
   } catch (const kin::RobotFileError& e) {
-    r.fail(fmt::format("\"{}\": {}", shipped ? "robot" : "robot_file", e.what()));
+    r.fail(fmt::format("\"{}\": {}", key, e.what()));
   }
   robot.base = parse_pose(r.get("base"), where + ": \"base\"");
   robot.period_multiple =
       static_cast<std::uint32_t>(r.integer("period_multiple", 1, kMaxPeriodMultiple));
-  const json& radius = r.get("link_radius_m");
-  if (radius.is_number()) {
+  // A model with collision capsules of its own (a URDF's <collision>) needs no link radii;
+  // one whose URDF gives meshes for some links does: rccx encloses no mesh.
+  const kin::CollisionModel& own = robot.model.collision;
+  if (!r.has("link_radius_m") && !own.capsules.empty() && own.mesh_links.empty()) {
+    // its own capsules stand for its links
+  } else if (!r.has("link_radius_m") && !own.mesh_links.empty()) {
+    r.fail(fmt::format(
+        "its URDF's <collision> of link{} {} {} a mesh, which rccx does not read: give "
+        "\"link_radius_m\" (capsules along the chain, of radii that enclose the arm), or give "
+        "those links <collision> spheres, cylinders or boxes enclosing the mesh",
+        own.mesh_links.size() == 1 ? "" : "s", fmt::join(own.mesh_links, ", "),
+        own.mesh_links.size() == 1 ? "is" : "are"));
+  } else if (const json& radius = r.get("link_radius_m"); radius.is_number()) {
     robot.link_radius_m.assign(robot.model.dof(), r.number("link_radius_m", kMaxRadius_m));
   } else if (radius.is_array() && radius.size() <= kin::kMaxJoints) {
     for (std::size_t i = 0; i < radius.size(); ++i) {
@@ -530,6 +574,18 @@ CellModel load_cell_file(const std::filesystem::path& path) {
 
 double reach_m(const kin::RobotModel& model, const std::optional<math::Transform>& tool) {
   double sum = 0.0;
+  if (model.geometry == kin::Geometry::chain) {
+    // Each joint moves the next frame's origin by at most its offsets (origin, after) and a
+    // prismatic joint's travel; rotations move nothing farther from the previous origin.
+    for (const kin::Joint& j : model.joints) {
+      sum += j.chain.origin.p.norm() + j.chain.after.p.norm();
+      if (j.type == kin::JointType::prismatic) {
+        sum += std::max(std::abs(j.lower), std::abs(j.upper));
+      }
+    }
+    if (tool) sum += tool->p.norm();
+    return sum;
+  }
   for (const kin::Joint& j : model.joints) {
     sum += std::abs(j.dh.a_m);
     if (j.type == kin::JointType::prismatic) {

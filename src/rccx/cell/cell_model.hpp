@@ -50,9 +50,12 @@ struct CellRobot {
   std::string name;  ///< its name in the cell ("puma"), unique among the robots
   kin::RobotModel model;
   std::string model_file;  ///< the robot file as the cell names it; empty for a shipped robot
+  std::string urdf_file;   ///< the URDF as the cell names it ("urdf"); empty otherwise
   math::Transform base;    ///< world <- robot base frame, m
-  std::uint32_t period_multiple = 1;    ///< sampled every k-th tick of the cell's clock
-  std::vector<double> link_radius_m;    ///< capsule radius per joint's link, m (dof() values)
+  std::uint32_t period_multiple = 1;  ///< sampled every k-th tick of the cell's clock
+  /// Capsule radius per joint's link, m (dof() values); empty when the model has collision
+  /// capsules of its own (a URDF's <collision>) and the cell file gives none.
+  std::vector<double> link_radius_m;
   std::optional<math::Transform> tool;  ///< T6 <- tool frame, m; none: the tool is T6
   /// Named capsules beyond the links; without one in T6, a robot with a tool gets a capsule
   /// from T6's origin to the tool's of its last link's radius (cell::Cell).
@@ -123,8 +126,8 @@ class CellFileError : public std::runtime_error {
 void validate(const CellModel& cell, std::string_view origin = "cell");
 
 /// Parses a cell description (JSON with // comments; cells/README.md). `origin` names the text
-/// in messages; `"robot_file"` paths are relative to `base_dir` (when base_dir is empty,
-/// robot files are refused: the text has no place on disk).
+/// in messages; `"robot_file"` and `"urdf"` paths are relative to `base_dir` (when base_dir
+/// is empty, they are refused: the text has no place on disk).
 CellModel parse_cell(std::string_view text, std::string_view origin,
                      const std::filesystem::path& base_dir);
 /// Reads and parses a cell file; its robot files are found relative to its directory.

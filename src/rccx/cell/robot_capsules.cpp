@@ -32,7 +32,10 @@ RobotCapsules::RobotCapsules(const kin::RobotModel& model, std::span<const doubl
                                 " joints; collision capsules need 1 to " +
                                 std::to_string(kin::kMaxJoints));
   }
-  if (link_radius_m.size() != 1 && link_radius_m.size() != dof) {
+  const std::vector<kin::LinkCapsule>& own = model.collision.capsules;
+  const bool none_ok = !own.empty();  // the model's own capsules stand for its links
+  if (link_radius_m.size() != 1 && link_radius_m.size() != dof &&
+      !(none_ok && link_radius_m.empty())) {
     throw std::invalid_argument(
         "robot " + model.name + ": " + std::to_string(link_radius_m.size()) +
         " link radii; give one, or one per joint (" + std::to_string(dof) + ")");
@@ -47,14 +50,68 @@ RobotCapsules::RobotCapsules(const kin::RobotModel& model, std::span<const doubl
     throw std::invalid_argument(
         fmt::format("robot {}: {} shapes; at most {}", model.name, shapes.size(), kMaxShapes));
   }
+  if (own.size() > kin::kMaxCollisionCapsules) {
+    throw std::invalid_argument(
+        fmt::format("robot {}: {} collision capsules of its own; at most {}", model.name,
+                    own.size(), kin::kMaxCollisionCapsules));
+  }
   chain_ = kin::DhChain(model);
   q_ = kin::JointVector(dof);
+  if (!link_radius_m.empty()) {
+    if (model.geometry == kin::Geometry::chain) {
+      add_link_pieces_chain(model, link_radius_m);
+    } else {
+      add_link_pieces_dh(link_radius_m);
+    }
+  } else if (model.geometry == kin::Geometry::dh) {
+    add_link_pieces_dh(std::array<double, 1>{0.0});  // only for origin_frames_: dropped below
+    count_ = 0;
+  } else {
+    add_link_pieces_chain(model, std::array<double, 1>{0.0});
+    count_ = 0;
+  }
+  // Named capsules: the model's own (named by their link), then the cell's shapes.
+  const auto add_named = [&](std::size_t frame, const math::Vec3& from, const math::Vec3& to,
+                             double radius, const std::string& name, bool shape) {
+    if (frame > dof) {
+      throw std::invalid_argument(
+          fmt::format("robot {}: {} \"{}\" is in frame {}; 0 (the base) to {} (T6)", model.name,
+                      shape ? "shape" : "collision capsule of link", name, frame, dof));
+    }
+    if (!finite(from) || !finite(to) || !std::isfinite(radius) || radius < 0.0) {
+      throw std::invalid_argument(fmt::format(
+          "robot {}: {} \"{}\": its points and radius must be finite, the radius not negative",
+          model.name, shape ? "shape" : "collision capsule of link", name));
+    }
+    Capsule& c = capsules_[count_];
+    c.link = static_cast<std::uint8_t>(frame == 0 ? 0 : frame - 1);
+    c.radius_m = radius;
+    c.shape = static_cast<std::int8_t>(shape_names_.size());
+    c.tool = shape && frame == dof;
+    // A base shape never moves: it rests on what the robot stands on.
+    c.mounting = frame == 0 || (frame <= origin_frames_ &&
+                                (from.norm() <= kZeroLength_m || to.norm() <= kZeroLength_m));
+    pieces_[count_++] = {static_cast<std::uint8_t>(frame), Motion::fixed, 0, from, to};
+    shape_names_.push_back(name);
+  };
+  for (const kin::LinkCapsule& k : own) {
+    add_named(k.frame, k.from_m, k.to_m, k.radius_m, k.link, false);
+  }
+  for (const RobotShape& s : shapes) add_named(s.frame, s.from_m, s.to_m, s.radius_m, s.name, true);
+  const kin::JointVector ready = model.ready();
+  if (!update(ready)) {
+    throw std::invalid_argument("robot " + model.name + ": the ready pose is not finite");
+  }
+  settle();
+}
+
+void RobotCapsules::add_link_pieces_dh(std::span<const double> link_radius_m) {
+  const std::size_t dof = chain_.dof;
   const auto radius = [&](std::size_t i) {
     return link_radius_m.size() == 1 ? link_radius_m[0] : link_radius_m[i];
   };
   // Frames 0 .. k have their origins at the base's in every configuration while every link
   // before them is a pure rotation: pieces that start there reach the base origin always.
-  std::size_t origin_frames = 0;  // frames 0 .. origin_frames sit at the base origin
   for (std::size_t i = 0; i < dof; ++i) {
     const kin::DhChain::Link& l = chain_.links[i];
     const auto add = [&](std::size_t frame, bool prismatic, const math::Vec3& from,
@@ -62,12 +119,14 @@ RobotCapsules::RobotCapsules(const kin::RobotModel& model, std::span<const doubl
       Capsule& c = capsules_[count_];
       c.link = static_cast<std::uint8_t>(i);
       c.radius_m = radius(i);
-      c.mounting = frame <= origin_frames && from.norm() <= kZeroLength_m;
-      pieces_[count_++] = {static_cast<std::uint8_t>(frame), prismatic, from, to};
+      c.mounting = frame <= origin_frames_ && from.norm() <= kZeroLength_m;
+      pieces_[count_++] = {static_cast<std::uint8_t>(frame),
+                           prismatic ? Motion::dh_prismatic : Motion::fixed,
+                           static_cast<std::uint8_t>(i), from, to};
     };
     const bool d_part = l.prismatic || std::abs(l.d_m) > kZeroLength_m;
     const bool a_part = std::abs(l.a_m) > kZeroLength_m;
-    if (!d_part && !a_part && origin_frames == i) origin_frames = i + 1;
+    if (!d_part && !a_part && origin_frames_ == i) origin_frames_ = i + 1;
     // The d part, in frame i-1: from its origin along its z.
     if (d_part) add(i, l.prismatic, {0, 0, 0}, {0, 0, l.d_m});
     // The a part, in frame i: from -a along its x to its origin.
@@ -75,33 +134,39 @@ RobotCapsules::RobotCapsules(const kin::RobotModel& model, std::span<const doubl
     // Neither: the joint as a sphere at frame i's origin (where frame i-1's is too).
     if (!d_part && !a_part) add(i + 1, false, {0, 0, 0}, {0, 0, 0});
   }
-  for (const RobotShape& s : shapes) {
-    if (s.frame > dof) {
-      throw std::invalid_argument(
-          fmt::format("robot {}: shape \"{}\" is in frame {}; 0 (the base) to {} (T6)", model.name,
-                      s.name, s.frame, dof));
-    }
-    if (!finite(s.from_m) || !finite(s.to_m) || !std::isfinite(s.radius_m) || s.radius_m < 0.0) {
-      throw std::invalid_argument(fmt::format(
-          "robot {}: shape \"{}\": its points and radius must be finite, the radius not negative",
-          model.name, s.name));
-    }
-    Capsule& c = capsules_[count_];
-    c.link = static_cast<std::uint8_t>(s.frame == 0 ? 0 : s.frame - 1);
-    c.radius_m = s.radius_m;
-    c.shape = static_cast<std::int8_t>(shape_names_.size());
-    c.tool = s.frame == dof;
-    // A base shape never moves: it rests on what the robot stands on.
-    c.mounting = s.frame == 0 || (s.frame <= origin_frames && (s.from_m.norm() <= kZeroLength_m ||
-                                                               s.to_m.norm() <= kZeroLength_m));
-    pieces_[count_++] = {static_cast<std::uint8_t>(s.frame), false, s.from_m, s.to_m};
-    shape_names_.push_back(s.name);
+}
+
+void RobotCapsules::add_link_pieces_chain(const kin::RobotModel& model,
+                                          std::span<const double> link_radius_m) {
+  const std::size_t dof = chain_.dof;
+  const auto radius = [&](std::size_t i) {
+    return link_radius_m.size() == 1 ? link_radius_m[0] : link_radius_m[i];
+  };
+  for (std::size_t i = 0; i < dof; ++i) {
+    const kin::ChainStep& step = model.joints[i].chain;
+    const bool prismatic = model.joints[i].type == kin::JointType::prismatic;
+    const auto add = [&](std::size_t frame, Motion motion, const math::Vec3& from,
+                         const math::Vec3& to) {
+      Capsule& c = capsules_[count_];
+      c.link = static_cast<std::uint8_t>(i);
+      c.radius_m = radius(i);
+      c.mounting = frame <= origin_frames_ && from.norm() <= kZeroLength_m;
+      pieces_[count_++] = {static_cast<std::uint8_t>(frame), motion, static_cast<std::uint8_t>(i),
+                           from, to};
+    };
+    const bool offset = step.origin.p.norm() > kZeroLength_m;
+    const bool flange = step.after.p.norm() > kZeroLength_m;  // the last joint's only
+    // A link reached by rotations alone keeps its origin at the base's.
+    if (!offset && !prismatic && origin_frames_ == i) origin_frames_ = i + 1;
+    // From frame i-1's origin to joint i's, in frame i-1.
+    if (offset) add(i, Motion::fixed, {0, 0, 0}, step.origin.p);
+    // A prismatic joint's travel, from its origin along its axis (in frame i-1).
+    if (prismatic) add(i, Motion::chain_prismatic, step.origin.p, step.origin.R * step.axis);
+    // On to the flange, in T6: from the last link's origin (before `after`) to T6's.
+    if (flange) add(i + 1, Motion::fixed, step.after.inverse().p, {0, 0, 0});
+    // Neither: the joint as a sphere at frame i's origin.
+    if (!offset && !prismatic && !flange) add(i + 1, Motion::fixed, {0, 0, 0}, {0, 0, 0});
   }
-  const kin::JointVector ready = model.ready();
-  if (!update(ready)) {
-    throw std::invalid_argument("robot " + model.name + ": the ready pose is not finite");
-  }
-  settle();
 }
 
 bool RobotCapsules::update(const kin::JointVector& q) noexcept {
@@ -121,12 +186,17 @@ bool RobotCapsules::update(const kin::JointVector& q) noexcept {
     Capsule& c = capsules_[k];
     const math::Transform& frame = piece.frame == 0 ? base_ : frames[piece.frame - 1];
     c.p0_m = frame * piece.from_m;
-    if (piece.prismatic) {
-      // The d part of joint `frame` + 1 (0-based: frame), its length d + q.
-      const std::size_t j = piece.frame;
-      c.p1_m = frame.p + frame.R.a * (chain_.links[j].d_m + q[j]);
-    } else {
-      c.p1_m = frame * piece.to_m;
+    const std::size_t j = piece.joint;
+    switch (piece.motion) {
+      case Motion::dh_prismatic:  // joint j's d part, its length d + q
+        c.p1_m = frame.p + frame.R.a * (chain_.links[j].d_m + q[j]);
+        break;
+      case Motion::chain_prismatic:  // joint j's travel along its axis
+        c.p1_m = c.p0_m + frame.R * piece.to_m * q[j];
+        break;
+      case Motion::fixed:
+        c.p1_m = frame * piece.to_m;
+        break;
     }
     c.bounds = bounds_of(c.p0_m, c.p1_m, c.radius_m);
     if (first) {

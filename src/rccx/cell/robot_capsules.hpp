@@ -11,8 +11,13 @@
 // along z_(i-1), then a_i along x_i (standard DH). Each non-zero part is one capsule (a
 // prismatic joint's d part is always one, since its length changes with q). A link with
 // neither (a wrist joint: the PUMA's links 5 and 6, the Microbo's 1, 4, 5 and 6) is a sphere
-// at its frame's origin, so that no joint is left out. Radii: one per link, from the cell file.
-// Named shapes (RobotShape) add what the DH chain does not say: a pedestal in the base frame, a
+// at its frame's origin, so that no joint is left out. Link i of a general chain (a URDF's,
+// kin::Geometry::chain) runs from frame i-1's origin to joint i's (its origin's offset), and
+// the last link on to the flange (its `after`); a prismatic joint's travel is a capsule of its
+// own. Radii: one per link, from the cell file. A model with its own collision capsules
+// (kin::RobotModel::collision, a URDF's <collision> geometry) adds those, in their frames,
+// named by their URDF link in messages; its link radii may then be left out (none given).
+// Named shapes (RobotShape) add what the chain does not say: a pedestal in the base frame, a
 // flange, a hand and the tool in T6.
 //
 // What the pieces are is worked out once at construction (which may allocate and throw);
@@ -38,15 +43,19 @@ namespace rccx::cell {
 
 class RobotCapsules {
  public:
-  /// Two capsules per joint (the d part and the a part, or the joint's sphere) and the shapes.
+  /// Two capsules per joint (the d part and the a part, or the joint's sphere; a chain's offset
+  /// and its prismatic travel), the model's own collision capsules and the shapes.
   static constexpr std::size_t kMaxShapes = kMaxRobotShapes;
-  static constexpr std::size_t kMaxCapsules = 2 * kin::kMaxJoints + kMaxShapes;
+  static constexpr std::size_t kMaxCapsules =
+      2 * kin::kMaxJoints + 1 + kin::kMaxCollisionCapsules + kMaxShapes;
 
-  /// `link_radius_m` holds one radius (m) for every link or one per joint; `base` places the
-  /// robot's frame 0 in the world; `shapes` adds named capsules (at most kMaxShapes). Throws
-  /// std::invalid_argument for a model of more than kin::kMaxJoints joints or none, a wrong
-  /// number of radii, a radius that is negative or not finite, or a bad shape (a frame past
-  /// T6, a point or radius not finite). The capsules start at the model's ready pose.
+  /// `link_radius_m` holds one radius (m) for every link or one per joint, or none when the
+  /// model has collision capsules of its own; `base` places the robot's frame 0 in the world;
+  /// `shapes` adds named capsules (at most kMaxShapes). Throws std::invalid_argument for a
+  /// model of more than kin::kMaxJoints joints or none, a wrong number of radii, a radius that
+  /// is negative or not finite, more than kin::kMaxCollisionCapsules model capsules, or a bad
+  /// shape or model capsule (a frame past T6, a point or radius not finite). The capsules start
+  /// at the model's ready pose.
   RobotCapsules(const kin::RobotModel& model, std::span<const double> link_radius_m,
                 const math::Transform& base = math::Transform::identity(),
                 std::span<const RobotShape> shapes = {});
@@ -60,6 +69,22 @@ class RobotCapsules {
   void settle() noexcept { moved_ = false; }
   /// True when update() has moved the capsules since the last settle().
   [[nodiscard]] bool moved() const noexcept { return moved_; }
+
+  /// How a piece's far end follows its joint: fixed in its frame; a DH prismatic joint's d
+  /// part (the far end along z by d + q); a chain's prismatic travel (from_m, the joint's
+  /// origin, to from_m + to_m q, to_m the axis in that frame).
+  enum class Motion : std::uint8_t { fixed, dh_prismatic, chain_prismatic };
+  /// Where a capsule is: a segment in frame `frame` (0 base, i link i).
+  struct Piece {
+    std::uint8_t frame = 0;
+    Motion motion = Motion::fixed;
+    std::uint8_t joint = 0;  ///< the prismatic joint (0-based) of a moving piece
+    math::Vec3 from_m;
+    math::Vec3 to_m;
+  };
+  /// Where each capsule is, in its frame, in the order of capsules(): what the view draws
+  /// the collision model from.
+  [[nodiscard]] std::span<const Piece> pieces() const noexcept { return {pieces_.data(), count_}; }
 
   [[nodiscard]] std::span<const Capsule> capsules() const noexcept {
     return {capsules_.data(), count_};
@@ -90,14 +115,11 @@ class RobotCapsules {
   void set_mounted_on(int object) noexcept { mounted_on_ = object; }
 
  private:
-  /// Where a capsule is: a segment in frame `frame` (0 base, i link i), whose far end moves
-  /// along z by the joint value when `prismatic` (the d part of a prismatic joint).
-  struct Piece {
-    std::uint8_t frame = 0;
-    bool prismatic = false;
-    math::Vec3 from_m;
-    math::Vec3 to_m;
-  };
+  void add_link_pieces_dh(std::span<const double> link_radius_m);
+  void add_link_pieces_chain(const kin::RobotModel& model, std::span<const double> link_radius_m);
+  /// Frames 0 .. this sit at the base origin in every configuration (every link before them
+  /// a pure rotation): pieces from their origin rest on what the robot stands on.
+  std::size_t origin_frames_ = 0;
 
   kin::DhChain chain_;
   math::Transform base_;

@@ -79,6 +79,30 @@ struct Joint {
   JointDynamics dynamics;
 };
 
+/// A capsule fixed in one of the robot's frames, m: the points within radius_m of the segment
+/// from_m .. to_m. A robot's own collision model (RobotModel::collision), read from a URDF's
+/// <collision> geometry, each primitive enclosed by one (collision_geometry.hpp).
+struct LinkCapsule {
+  std::size_t frame = 0;  ///< 0: the base frame; i: link i's frame (dof: T6, the flange)
+  math::Vec3 from_m;
+  math::Vec3 to_m;
+  double radius_m = 0.0;
+  std::string link;  ///< the URDF link whose geometry it encloses
+};
+
+/// Capsules a robot's own collision model may have for the cell's check (cell::RobotCapsules).
+inline constexpr std::size_t kMaxCollisionCapsules = 32;
+
+/// The robot's own collision model. Empty for a DH robot file: the cell's "link_radius_m"
+/// capsules stand for its links then.
+struct CollisionModel {
+  std::vector<LinkCapsule> capsules;
+  /// Links whose <collision> is a mesh, which rccx does not enclose: a cell asks for
+  /// "link_radius_m" for such a robot rather than take the primitives alone.
+  std::vector<std::string> mesh_links;
+  [[nodiscard]] bool empty() const noexcept { return capsules.empty() && mesh_links.empty(); }
+};
+
 /// Which solver a model asks for: the thesis's closed form for the Microbo, the PUMA closed
 /// form, or the numeric solver that serves any DH chain.
 enum class SolverKind : std::uint8_t { microbo, puma, dh };
@@ -103,6 +127,8 @@ struct RobotModel {
   /// robot's controller needs (the Microbo's RCU), parsed and checked by rccx::hw.
   std::string hardware_json;
   Plant plant = Plant::automatic;
+  /// Capsules enclosing the links' <collision> geometry (a URDF's); empty for DH robot files.
+  CollisionModel collision;
 
   [[nodiscard]] std::size_t dof() const noexcept { return joints.size(); }
   [[nodiscard]] JointVector ready() const noexcept;

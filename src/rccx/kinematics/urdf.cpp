@@ -17,6 +17,8 @@
 #include <sstream>
 #include <vector>
 
+#include "rccx/kinematics/collision_geometry.hpp"
+
 namespace rccx::kin {
 
 namespace {
@@ -297,6 +299,51 @@ class Reader {
     return I;
   }
 
+  /// The link's <collision> primitives as capsules enclosing them, placed by `where` into the
+  /// frame `frame` (0 the base, i link i); a mesh only names its link (CollisionModel).
+  void add_collision(const urdf::Link& link, const math::Transform& where, std::size_t frame,
+                     CollisionModel& out) const {
+    for (const urdf::CollisionSharedPtr& c : link.collision_array) {
+      if (c == nullptr || c->geometry == nullptr) continue;
+      const std::string what = fmt::format("link '{}''s <collision>", link.name);
+      const math::Transform at = where * to_transform(c->origin);
+      check_transform(at, what + " origin");
+      const auto size = [&](double v, const char* name) {
+        if (!std::isfinite(v) || v < 0.0 || v > kMaxOffset_m) {
+          fail(fmt::format("{}: {} {} (give 0 to {} m)", what, name, v, kMaxOffset_m));
+        }
+        return v;
+      };
+      LinkCapsule capsule;
+      switch (c->geometry->type) {
+        case urdf::Geometry::SPHERE:
+          capsule = enclose_sphere(
+              at, size(static_cast<const urdf::Sphere&>(*c->geometry).radius, "radius"));
+          break;
+        case urdf::Geometry::CYLINDER: {
+          const auto& g = static_cast<const urdf::Cylinder&>(*c->geometry);
+          capsule = enclose_cylinder(at, size(g.radius, "radius"), size(g.length, "length"));
+          break;
+        }
+        case urdf::Geometry::BOX: {
+          const auto& d = static_cast<const urdf::Box&>(*c->geometry).dim;
+          capsule =
+              enclose_box(at, {size(d.x, "size x"), size(d.y, "size y"), size(d.z, "size z")});
+          break;
+        }
+        default:  // a mesh: rccx reads no mesh files
+          if (std::find(out.mesh_links.begin(), out.mesh_links.end(), link.name) ==
+              out.mesh_links.end()) {
+            out.mesh_links.push_back(link.name);
+          }
+          continue;
+      }
+      capsule.frame = frame;
+      capsule.link = link.name;
+      out.capsules.push_back(std::move(capsule));
+    }
+  }
+
   RobotModel build(const urdf::ModelInterface& model,
                    const std::vector<urdf::LinkConstSharedPtr>& chain,
                    const urdf::LinkConstSharedPtr& base) const {
@@ -311,6 +358,7 @@ class Reader {
     double mass = 0.0;
     math::Vec3 moment;
     SecondMoment second;
+    add_collision(*base, pending, 0, out.collision);
     // `own`: the link's frame in the frame its bodies were gathered in (the last link's is the
     // flange's).
     const auto close_link = [&](Joint* j, const math::Transform& own) {
@@ -336,6 +384,7 @@ class Reader {
       if (uj.type == urdf::Joint::FIXED) {
         pending = pending * origin;
         add_inertial(link, pending, mass, moment, second);
+        add_collision(link, pending, out.joints.size(), out.collision);
         continue;
       }
       if (uj.type != urdf::Joint::REVOLUTE && uj.type != urdf::Joint::CONTINUOUS &&
@@ -398,6 +447,7 @@ class Reader {
       moment = {};
       second = {};
       add_inertial(link, pending, mass, moment, second);
+      add_collision(link, pending, out.joints.size(), out.collision);
     }
     if (out.joints.empty()) {
       fail(fmt::format("no moving joint between '{}' and '{}'", base->name, chain.back()->name));
@@ -407,7 +457,20 @@ class Reader {
     Joint& last = out.joints.back();
     last.chain.after = pending;
     close_link(&last, pending);
+    place_collision_in_t6(out);
     return out;
+  }
+
+  /// The last link's capsules were gathered in its own frame; T6 is the flange's (`after`).
+  /// Then capsules inside others go (a URDF capsule is a cylinder and two spheres).
+  static void place_collision_in_t6(RobotModel& model) {
+    const math::Transform to_t6 = model.joints.back().chain.after.inverse();
+    for (LinkCapsule& c : model.collision.capsules) {
+      if (c.frame != model.dof()) continue;
+      c.from_m = to_t6 * c.from_m;
+      c.to_m = to_t6 * c.to_m;
+    }
+    drop_enclosed(model.collision.capsules);
   }
 
   std::string origin_;

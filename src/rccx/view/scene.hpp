@@ -1,6 +1,7 @@
-// What the view draws, as data: robots (each its DH chain with the robot's dimensions, its base
-// transform, tool and capsule radii), the cell's objects and named frames. The page receives it
-// as JSON (GET /api/scene) and draws every link from it; the joint values arrive apart.
+// What the view draws, as data: robots (each its chain, DH or URDF, every joint as an origin, an
+// axis and an `after` transform, its base transform, tool and collision capsules), the cell's
+// objects and named frames. The page receives it as JSON (GET /api/scene) and draws every link
+// from it; the joint values arrive apart.
 //
 //   const view::Scene scene = view::Scene::of_cell(cell::load_cell_file("cells/cvarl.json"));
 //   const nlohmann::json page = view::to_json(scene);   // what GET /api/scene returns
