@@ -8,7 +8,8 @@
 // The lesson: a goal through another robot's frame, as RCCL wrote tracking. The UR5e presents
 // the bar at the hand-over point; the Panda's grip is written on the UR5e's tool,
 //
-//     T6 PANDA_TOOL = BASE_INV(panda) UR5E_TOOL PANDA_GRIP        UR5E_TOOL = cell.tool_frame("ur5e")
+//     T6 PANDA_TOOL = BASE_INV(panda) UR5E_TOOL PANDA_GRIP        UR5E_TOOL =
+//     cell.tool_frame("ur5e")
 //
 // (PANDA_GRIP: 160 mm along the bar, turned to face back), so it closes on the bar where the
 // UR5e holds it, not where the program thought it would be.
@@ -18,8 +19,8 @@
 //   2. When that motion has ended, the Panda comes in: a joint move to 80 mm behind its grip,
 //      then a line onto the grip through the UR5e's frame, and closes its hand.
 //   3. Both hold the bar for a second: what this program measures.
-//   4. The UR5e opens its hand and backs off along its line; once it is clear, the Panda carries
-//      the bar 250 mm aside and 100 mm down; both park.
+//   4. The UR5e opens its hand and backs off along its line; once it is clear, the Panda lifts
+//      the bar 150 mm; both park.
 //
 // Measured during the hold, at every sample, on MuJoCo's own bodies (hw::MujocoArm::body_pose):
 // each arm's flange against where its commanded joints put it (holding the pose against
@@ -50,7 +51,7 @@ using namespace std::chrono_literals;
 using namespace rccx::math::literals;
 
 constexpr double kHoldTolerance_m = 0.5e-3;  // issue 26: each arm holds its pose within 0.5 mm
-constexpr double kBarLength_m = 0.160;        // between the two grips
+constexpr double kBarLength_m = 0.160;       // between the two grips
 constexpr auto kTimeout = 60s;
 
 /// Tool z along +x of the world (the UR5e's, pointing at the Panda), fingers' x down.
@@ -68,12 +69,13 @@ struct Worst {
 /// -x end as each hand has it, in the world.
 class Measure {
  public:
-  Measure(cell::Cell& c, const math::Transform& panda_grip) : c_(c), grip_inverse_(panda_grip.inverse()) {
+  Measure(cell::Cell& c, const math::Transform& panda_grip)
+      : c_(c), grip_inverse_(panda_grip.inverse()) {
     for (const char* name : {"ur5e", "panda"}) {
       auto* mj = dynamic_cast<hw::MujocoArm*>(c.hardware(name).arm.get());
       if (mj == nullptr) {
-        throw std::invalid_argument(fmt::format(
-            "robot {} is not on the MuJoCo plant (its robot file's \"plant\")", name));
+        throw std::invalid_argument(
+            fmt::format("robot {} is not on the MuJoCo plant (its robot file's \"plant\")", name));
       }
       (name[0] == 'u' ? ur_ : panda_) = mj;
     }
@@ -81,7 +83,8 @@ class Measure {
 
   /// Lets `seconds` pass one tick at a time, measuring at each.
   void hold(double seconds) {
-    const auto ticks = static_cast<long>(seconds / std::chrono::duration<double>(c_.model().base_period).count());
+    const auto ticks =
+        static_cast<long>(seconds / std::chrono::duration<double>(c_.model().base_period).count());
     for (long k = 0; k < ticks; ++k) {
       c_.wait_for(c_.model().base_period);
       ur_hold_.add(hold_error("ur5e", *ur_));
@@ -97,11 +100,13 @@ class Measure {
     fmt::print("hold, {} samples of {} ms on MuJoCo's bodies:\n", samples_,
                std::chrono::duration<double, std::milli>(c_.model().base_period).count());
     fmt::print("  UR5e flange from its commanded pose:  worst {:.4f} mm\n", ur_hold_.value * 1e3);
-    fmt::print("  Panda flange from its commanded pose: worst {:.4f} mm\n", panda_hold_.value * 1e3);
+    fmt::print("  Panda flange from its commanded pose: worst {:.4f} mm\n",
+               panda_hold_.value * 1e3);
     fmt::print("  the bar's end as each hand holds it:  worst {:.4f} mm apart\n", gap_.value * 1e3);
   }
   [[nodiscard]] bool held() const {
-    return samples_ > 0 && ur_hold_.value <= kHoldTolerance_m && panda_hold_.value <= kHoldTolerance_m;
+    return samples_ > 0 && ur_hold_.value <= kHoldTolerance_m &&
+           panda_hold_.value <= kHoldTolerance_m;
   }
 
  private:
@@ -142,8 +147,9 @@ int run(cell::Cell& c, double speed_m_per_s) {
   // The Panda's hand at the +x end, facing back (half a turn about the hand's x).
   const math::Transform panda_grip{math::Rot3::rot_x(180_deg), {0, 0, kBarLength_m}};
   const math::Transform panda_back = panda_grip * math::Transform::translation(0, 0, -0.080);
+  // Where the Panda takes the bar: 150 mm up (the hand's x is down).
   const math::Transform panda_aside =
-      ur_at * panda_grip * math::Transform::translation(0.100, 0.250, 0.0);  // hand x is down
+      ur_at * panda_grip * math::Transform::translation(-0.150, 0.0, 0.0);
 
   Measure measure(c, panda_grip);  // throws for a robot not on MuJoCo
   c.start();
@@ -180,20 +186,34 @@ int run(cell::Cell& c, double speed_m_per_s) {
   ur.set_mode(rccl::Mode::cartesian);
   const rccl::Motion present = ur.move(ur_present);
 
-  // 2. The Panda comes in once the bar is there, onto the UR5e's frame.
+  // 2. The Panda comes in once the bar is there, onto the UR5e's frame. Its swing is queued now
+  // and starts at the sample after the UR5e's motion ends; the lines through the UR5e's frame
+  // are queued once the bar is there (a goal is checked for reach as it is when queued).
   panda.move(panda_near, c.after("ur5e", present.end()));
+  wait(ur, present.end(), "the UR5e's presentation");
   panda.set_mode(rccl::Mode::cartesian);
   panda.move(panda_back_p);
+  // The last 80 mm slowly: the hands come within 70 mm of each other (their capsules), and the
+  // collision check's braking allowance grows with speed.
+  panda.set_velocity(0.02, 20_deg);
   const rccl::Motion grip = panda.move(panda_grip_p);
+  // Once it holds the bar, the Panda stops following the UR5e's frame (an arm at rest after a
+  // motion to a moving goal keeps tracking it, as RCCL's did): the grip's pose as a constant.
+  const auto panda_hold = c.world_goal("panda", "PANDA_HOLD", ur_at * panda_grip);
+  const rccl::Motion still = panda.move(panda_hold);
   wait(panda, grip.end(), "the Panda's grip");
   panda.set_hand(true);
+  wait(panda, still.end(), "the Panda's hold");
 
   // 3. Both hold the bar.
   if (good) measure.hold(1.0);
 
   // 4. The UR5e lets go and backs off; the Panda carries the bar aside; both park.
   ur.set_hand(false);
-  const rccl::Motion back_off = ur.move(ur_short_p, c.after("panda", grip.end()));
+  ur.set_velocity(0.02, 20_deg);  // slowly out of the Panda's hand too
+  const rccl::Motion back_off = ur.move(ur_short_p, c.after("panda", still.end()));
+  ur.set_velocity(speed_m_per_s, 60_deg);
+  panda.set_velocity(speed_m_per_s, 60_deg);
   panda.move(panda_aside_p, c.after("ur5e", back_off.end()));
   ur.set_mode(rccl::Mode::joint);
   ur.move(ur.park());
@@ -206,7 +226,9 @@ int run(cell::Cell& c, double speed_m_per_s) {
   std::size_t failures = 0;
   for (rccl::Arm* arm : {&ur, &panda}) {
     for (const rccl::MotionEvent& f : arm->failures()) {
-      fmt::print(stderr, "14_handover: {}: {}\n", arm == &ur ? "UR5e" : "Panda", f.message());
+      fmt::print(stderr, "14_handover: {}: motion {} {} at {:.3f} s{}{}\n",
+                 arm == &ur ? "UR5e" : "Panda", f.id, rccl::to_string(f.kind), f.t_s,
+                 f.message().empty() ? "" : ": ", f.message());
       ++failures;
     }
   }
