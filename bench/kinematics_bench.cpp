@@ -322,27 +322,6 @@ struct NumericCheck {
   double max_error = 0.0;  // over the successful answers: max |FK(q) - pose| element
 };
 
-NumericCheck check_dh_ik(const IkPool& pool, const rccx::kin::DhKinematics& dh = dh_puma()) {
-  NumericCheck c;
-  if (!pool.error.empty()) {
-    c.error = pool.error;
-    return c;
-  }
-  std::size_t ok = 0;
-  for (std::size_t s = 0; s < pool.pose.size(); ++s) {
-    const IkResult r = dh.inverse(pool.pose[s], pool.seeded[s]);
-    if (!r) continue;
-    ++ok;
-    c.max_error = std::max(c.max_error, max_diff(dh.forward(r.q), pool.pose[s]));
-  }
-  c.ok_rate = static_cast<double>(ok) / static_cast<double>(pool.pose.size());
-  if (ok == 0) c.error = "the DH solver solved no sample";
-  if (c.max_error > kIkTolerance) {
-    c.error = "DH IK: FK(IK(pose)) != pose, max element error " + std::to_string(c.max_error);
-  }
-  return c;
-}
-
 /// KDL's LMA stops when |L .* twist error| < eps (1e-5) with weights L = (1, 1, 1, 0.01, 0.01,
 /// 0.01): its answers are good to about 1e-5 m and 1e-3 rad, and are checked to that.
 NumericCheck check_kdl_ik(const IkPool& pool, KdlPuma& kdl = kdl_puma(),
@@ -485,25 +464,6 @@ void BM_Puma560IKAll(benchmark::State& state) {
   run_ik_all(state, puma(), puma_ik_pool(), error);
 }
 
-/// The numeric solver over a pool from its seeds, after its check.
-void run_numeric_ik(benchmark::State& state, const rccx::kin::DhKinematics& dh, const IkPool& pool,
-                    const NumericCheck& check) {
-  if (!checked(state, check.error)) return;
-  const std::size_t n = pool.pose.size();
-  std::size_t i = 0;
-  std::int64_t ok = 0;
-  for (auto _ : state) {
-    const IkResult r = dh.inverse(pool.pose[i], pool.seeded[i]);
-    benchmark::DoNotOptimize(r);
-    ok += r ? 1 : 0;
-    if (++i == n) i = 0;
-  }
-  pool_counters(state, pool);
-  state.counters["ok_rate"] =
-      benchmark::Counter(static_cast<double>(ok), benchmark::Counter::kAvgIterations);
-  state.counters["max_err"] = check.max_error;
-}
-
 /// Any solver's inverse() from the pool's seeds (or, `from_ready`, with no seed): how many it
 /// solves and its worst round-trip error.
 NumericCheck check_seeded_ik(const Kinematics& k, const IkPool& pool, bool from_ready = false) {
@@ -571,8 +531,8 @@ void run_kdl_ik(benchmark::State& state, KdlPuma& kdl, const IkPool& pool,
 }
 
 void BM_DhIK(benchmark::State& state) {
-  static const NumericCheck check = check_dh_ik(puma_ik_pool());
-  run_numeric_ik(state, dh_puma(), puma_ik_pool(), check);
+  static const NumericCheck check = check_seeded_ik(dh_puma(), puma_ik_pool());
+  run_seeded_ik(state, dh_puma(), puma_ik_pool(), check);
 }
 
 void BM_KdlPuma560IK(benchmark::State& state) {
@@ -595,8 +555,8 @@ void BM_Ur5eIKAll(benchmark::State& state) {
 
 /// The numeric solver forced on the UR5e, from the seeds KDL gets (0.05 rad off each joint).
 void BM_Ur5eNumericIK(benchmark::State& state) {
-  static const NumericCheck check = check_dh_ik(ur5e_ik_pool(), numeric_ur5e());
-  run_numeric_ik(state, numeric_ur5e(), ur5e_ik_pool(), check);
+  static const NumericCheck check = check_seeded_ik(numeric_ur5e(), ur5e_ik_pool());
+  run_seeded_ik(state, numeric_ur5e(), ur5e_ik_pool(), check);
 }
 
 void BM_KdlUr5eIK(benchmark::State& state) {
