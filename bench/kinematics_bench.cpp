@@ -18,6 +18,7 @@
 #include <cmath>
 #include <cstdint>
 #include <memory>
+#include <numbers>
 #include <random>
 #include <string>
 #include <vector>
@@ -263,6 +264,19 @@ const IkPool& ur5e_ik_pool() {
   static const IkPool pool = make_ik_pool(ur5e());
   return pool;
 }
+/// The same poses with every seed the ready pose: a solve with no idea where the arm is.
+const IkPool& ur5e_ik_pool_from_ready() {
+  static const IkPool pool = [] {
+    IkPool p = ur5e_ik_pool();
+    const JointVector ready = ur5e().model().ready();
+    for (std::size_t s = 0; s < p.pose.size(); ++s) {
+      p.seeded[s].near = ready;
+      p.kdl_seed[s] = to_kdl(ready);
+    }
+    return p;
+  }();
+  return pool;
+}
 
 // ---- sanity checks (each computed once, then cached) --------------------------------------
 
@@ -320,7 +334,23 @@ struct NumericCheck {
   std::string error;
   double ok_rate = 0.0;
   double max_error = 0.0;  // over the successful answers: max |FK(q) - pose| element
+  /// KDL's LMA knows no joint limits: the share of the poses its answer (revolute joints moved
+  /// by whole turns where that helps) lies within them.
+  double within_limits_rate = -1.0;
 };
+
+/// q within the model's limits once each revolute joint is moved by whole turns towards them.
+bool within_limits_up_to_turns(const RobotModel& model, JointVector q) {
+  constexpr double kTurn = 2.0 * std::numbers::pi;
+  for (std::size_t i = 0; i < q.size(); ++i) {
+    const rccx::kin::Joint& j = model.joints[i];
+    if (j.type == rccx::kin::JointType::revolute && std::isfinite(j.lower)) {
+      while (q[i] < j.lower - 1e-9) q[i] += kTurn;
+      while (q[i] > j.upper + 1e-9) q[i] -= kTurn;
+    }
+  }
+  return model.within_limits(q, 1e-9);
+}
 
 /// KDL's LMA stops when |L .* twist error| < eps (1e-5) with weights L = (1, 1, 1, 0.01, 0.01,
 /// 0.01): its answers are good to about 1e-5 m and 1e-3 rad, and are checked to that.
@@ -332,11 +362,12 @@ NumericCheck check_kdl_ik(const IkPool& pool, KdlPuma& kdl = kdl_puma(),
     return c;
   }
   KDL::JntArray q_out(kdl.chain.getNrOfJoints());
-  std::size_t ok = 0;
+  std::size_t ok = 0, within = 0;
   double max_position = 0.0, max_rotation = 0.0;
   for (std::size_t s = 0; s < pool.pose.size(); ++s) {
     if (kdl.ik->CartToJnt(pool.kdl_seed[s], pool.kdl_pose[s], q_out) < 0) continue;
     ++ok;
+    if (within_limits_up_to_turns(ours.model(), from_kdl(q_out))) ++within;
     const Transform t = ours.forward(from_kdl(q_out));
     max_position = std::max(max_position, (t.p - pool.pose[s].p).norm());
     Transform rotation_only = t;
@@ -345,6 +376,7 @@ NumericCheck check_kdl_ik(const IkPool& pool, KdlPuma& kdl = kdl_puma(),
     c.max_error = std::max(c.max_error, max_diff(t, pool.pose[s]));
   }
   c.ok_rate = static_cast<double>(ok) / static_cast<double>(pool.pose.size());
+  c.within_limits_rate = static_cast<double>(within) / static_cast<double>(pool.pose.size());
   if (ok == 0) c.error = "KDL LMA solved no sample";
   if (max_position > kKdlPositionTolerance || max_rotation > kKdlRotationTolerance) {
     c.error = "KDL LMA: FK(IK(pose)) != pose, max position error " + std::to_string(max_position) +
@@ -527,6 +559,7 @@ void run_kdl_ik(benchmark::State& state, KdlPuma& kdl, const IkPool& pool,
       benchmark::Counter(static_cast<double>(ok), benchmark::Counter::kAvgIterations);
   state.counters["lma_iters"] =
       benchmark::Counter(static_cast<double>(iterations), benchmark::Counter::kAvgIterations);
+  state.counters["in_limits"] = check.within_limits_rate;
   state.counters["max_err"] = check.max_error;
 }
 
@@ -557,6 +590,18 @@ void BM_Ur5eIKAll(benchmark::State& state) {
 void BM_Ur5eNumericIK(benchmark::State& state) {
   static const NumericCheck check = check_seeded_ik(numeric_ur5e(), ur5e_ik_pool());
   run_seeded_ik(state, numeric_ur5e(), ur5e_ik_pool(), check);
+}
+
+/// Both numeric solvers from the ready pose: rccx's restarts from 16 seeds spread over the
+/// ranges when its first start fails; KDL's LMA starts once.
+void BM_Ur5eNumericIKFromReady(benchmark::State& state) {
+  static const NumericCheck check = check_seeded_ik(numeric_ur5e(), ur5e_ik_pool_from_ready());
+  run_seeded_ik(state, numeric_ur5e(), ur5e_ik_pool_from_ready(), check);
+}
+
+void BM_KdlUr5eIKFromReady(benchmark::State& state) {
+  static const NumericCheck check = check_kdl_ik(ur5e_ik_pool_from_ready(), kdl_ur5e(), ur5e());
+  run_kdl_ik(state, kdl_ur5e(), ur5e_ik_pool_from_ready(), check);
 }
 
 void BM_KdlUr5eIK(benchmark::State& state) {
@@ -606,6 +651,8 @@ BENCHMARK(BM_Ur5eIK);
 BENCHMARK(BM_Ur5eIKAll);
 BENCHMARK(BM_Ur5eNumericIK);
 BENCHMARK(BM_KdlUr5eIK);
+BENCHMARK(BM_Ur5eNumericIKFromReady);
+BENCHMARK(BM_KdlUr5eIKFromReady);
 BENCHMARK(BM_PandaIK);
 BENCHMARK(BM_PandaIKSeeded);
 BENCHMARK(BM_PandaIKFromReady);
