@@ -216,9 +216,9 @@ TEST_F(CliDbBadInput, PutRefusesBadArgumentsBeforeTouchingTheDatabase) {
       {"db --db {dir} put --robot microbo P --T " + std::string(kT), 2, "is a directory"},
       // A misspelt robot is refused, with the known ones and how to declare a new one.
       {"db --db {db} put --robot pmua560 P --T " + std::string(kT), 2,
-       "\"pmua560\" is not a known robot; did you mean puma560? (known: microbo, puma260, "
-       "puma560, stanford); check the spelling, or declare a new robot with --new-robot "
-       "pmua560"},
+       "\"pmua560\" is not a known robot; did you mean puma560? (known: microbo, panda, "
+       "puma260, puma560, stanford, ur5e); check the spelling, or declare a new robot with "
+       "--new-robot pmua560"},
       // --new-robot takes the robot's name, as import's does; the old switch is refused.
       {"db --db {db} put --robot gantry P --new-robot --T " + std::string(kT), 2, "not expected"},
       {"db --db {db} put --robot microbo P --xyz '' --rpy 0,0,0", 2, "empty"},
@@ -268,7 +268,8 @@ TEST_F(CliDbBadInput, AnUnknownRobotIsRefusedNamingTheNearest) {
     rccl::PositionDb(db).put(t);
     return std::shared_ptr<void>();
   };
-  const std::string nearest = "did you mean puma560? (known: microbo, puma260, puma560, stanford)";
+  const std::string nearest =
+      "did you mean puma560? (known: microbo, panda, puma260, puma560, stanford, ur5e)";
   run_all({
       {"db --db {db} list --robot pmua560", 2, nearest},
       {"db --db {db} list --robot MICROBOO", 2, "did you mean microbo?"},
@@ -463,8 +464,8 @@ TEST_F(CliDbBadInput, ImportIsStrictAndAllOrNothing) {
       {imp, 2, "key \"created_unix_s\"",
        in(export_with("[" + entry("microbo", "P", R"(, "created_unix_s": -1)") + "]"))},
       {imp, 2,
-       "robot \"gantry\", \"pmua560\" not known (known: microbo, puma260, puma560, "
-       "stanford); check the file, or declare each new robot with --new-robot NAME",
+       "robot \"gantry\", \"pmua560\" not known (known: microbo, panda, puma260, puma560, "
+       "stanford, ur5e); check the file, or declare each new robot with --new-robot NAME",
        in(export_with("[" + good + "," + entry("pmua560", "P") + "," + entry("gantry", "P") +
                       "]"))},
       {imp + " --new-robot gantry", 2, "robot \"pmua560\" not known",

@@ -34,51 +34,16 @@
 #include "rccx/kinematics/kinematics.hpp"
 #include "rccx/kinematics/urdf.hpp"
 #include "rccx/math/units.hpp"
+#include "urdf_kdl.hpp"
 
 namespace {
 
 using namespace rccx;
 const std::filesystem::path kRobots = RCCX_ROBOTS_DIR;
 
-KDL::Frame kdl_frame(const urdf::Pose& p) {
-  return {KDL::Rotation::Quaternion(p.rotation.x, p.rotation.y, p.rotation.z, p.rotation.w),
-          KDL::Vector(p.position.x, p.position.y, p.position.z)};
-}
-
-/// A link's inertial as kdl_parser turns it into a RigidBodyInertia about the link frame's
-/// origin: the tensor turned by the inertial origin's rotation, the mass at its position.
-KDL::RigidBodyInertia kdl_inertia(const urdf::Link& link) {
-  if (link.inertial == nullptr) return KDL::RigidBodyInertia::Zero();
-  const urdf::Inertial& i = *link.inertial;
-  const KDL::Frame origin = kdl_frame(i.origin);
-  const KDL::RigidBodyInertia turned =
-      origin.M *
-      KDL::RigidBodyInertia(0, KDL::Vector::Zero(),
-                            KDL::RotationalInertia(i.ixx, i.iyy, i.izz, i.ixy, i.ixz, i.iyz));
-  return KDL::RigidBodyInertia(i.mass, origin.p, turned.getRotationalInertia());
-}
-
-/// The KDL chain from `base` to `tip` with each link's inertia, built as kdl_parser builds it
-/// (fixed joints stay segments of their own; KDL's dynamics carry them).
-KDL::Chain kdl_chain_from_urdf(const urdf::ModelInterface& model, const std::string& base,
-                               const std::string& tip) {
-  std::vector<urdf::LinkConstSharedPtr> links{model.getLink(tip)};
-  while (links.back()->name != base) links.push_back(links.back()->getParent());
-  KDL::Chain chain;
-  for (auto it = links.rbegin() + 1; it != links.rend(); ++it) {
-    const urdf::Joint& j = *(*it)->parent_joint;
-    const KDL::Frame origin = kdl_frame(j.parent_to_joint_origin_transform);
-    const KDL::Vector axis(j.axis.x, j.axis.y, j.axis.z);
-    KDL::Joint joint(j.name, KDL::Joint::Fixed);
-    if (j.type == urdf::Joint::REVOLUTE || j.type == urdf::Joint::CONTINUOUS) {
-      joint = KDL::Joint(j.name, origin.p, origin.M * axis, KDL::Joint::RotAxis);
-    } else if (j.type == urdf::Joint::PRISMATIC) {
-      joint = KDL::Joint(j.name, origin.p, origin.M * axis, KDL::Joint::TransAxis);
-    }
-    chain.addSegment(KDL::Segment((*it)->name, joint, origin, kdl_inertia(**it)));
-  }
-  return chain;
-}
+using test::kdl_chain_from_urdf;
+using test::kdl_frame;
+using test::kdl_inertia;
 
 struct Case {
   const char* file;

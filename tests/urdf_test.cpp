@@ -25,6 +25,7 @@
 #include "rccx/kinematics/ur_kinematics.hpp"
 #include "rccx/kinematics/urdf.hpp"
 #include "rccx/math/units.hpp"
+#include "urdf_kdl.hpp"
 
 namespace kin = rccx::kin;
 namespace math = rccx::math;
@@ -33,32 +34,12 @@ namespace {
 
 const std::filesystem::path kRobots = RCCX_ROBOTS_DIR;
 
-KDL::Frame kdl_frame(const urdf::Pose& p) {
-  return {KDL::Rotation::Quaternion(p.rotation.x, p.rotation.y, p.rotation.z, p.rotation.w),
-          KDL::Vector(p.position.x, p.position.y, p.position.z)};
-}
-
 /// The KDL chain from `base` to `tip` of a URDF file, built as kdl_parser builds it.
 KDL::Chain kdl_chain_from_urdf(const std::filesystem::path& file, const std::string& base,
                                const std::string& tip) {
   const urdf::ModelInterfaceSharedPtr model = urdf::parseURDFFile(file.string());
   EXPECT_NE(model, nullptr) << file;
-  std::vector<urdf::LinkConstSharedPtr> links{model->getLink(tip)};
-  while (links.back()->name != base) links.push_back(links.back()->getParent());
-  KDL::Chain chain;
-  for (auto it = links.rbegin() + 1; it != links.rend(); ++it) {
-    const urdf::Joint& j = *(*it)->parent_joint;
-    const KDL::Frame origin = kdl_frame(j.parent_to_joint_origin_transform);
-    const KDL::Vector axis(j.axis.x, j.axis.y, j.axis.z);
-    KDL::Joint joint(j.name, KDL::Joint::Fixed);
-    if (j.type == urdf::Joint::REVOLUTE || j.type == urdf::Joint::CONTINUOUS) {
-      joint = KDL::Joint(j.name, origin.p, origin.M * axis, KDL::Joint::RotAxis);
-    } else if (j.type == urdf::Joint::PRISMATIC) {
-      joint = KDL::Joint(j.name, origin.p, origin.M * axis, KDL::Joint::TransAxis);
-    }
-    chain.addSegment(KDL::Segment((*it)->name, joint, origin));
-  }
-  return chain;
+  return rccx::test::kdl_chain_from_urdf(*model, base, tip);
 }
 
 double max_difference(const math::Transform& T, const KDL::Frame& F) {
