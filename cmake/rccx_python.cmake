@@ -52,6 +52,8 @@ if(RCCX_WITH_PYTHON)
 elseif(RCCX_PYTHON STREQUAL "ON")
   message(FATAL_ERROR "RCCX_PYTHON is ON but the Python module cannot be built: ${RCCX_PYTHON_REASON}; "
                       "scripts/install-deps installs what it needs")
+elseif(NOT RCCX_PYTHON)
+  message(STATUS "Python module rccx NOT built: ${RCCX_PYTHON_REASON}")
 else()
   message(STATUS "Python module rccx NOT built: ${RCCX_PYTHON_REASON}; scripts/install-deps installs what it needs")
 endif()
