@@ -619,6 +619,11 @@ int run_program(cell::Workcell& c, Watch& watch, const Options& o) {
   const rccl::StartWhen probe = c.touching({"board"});
   rccl::StartWhen after_present = c.after("puma", present.end());
   after_present.touch = probe.touch;
+  // Queued once the board is there: move() checks a goal through the PUMA's frame for reach as
+  // it is when queued, and with the board still on the stage or on its way (where it is at that
+  // moment depends on the machine's load, across processes) a pad can be out of the Microbo's
+  // limits.
+  wait(puma, present.end());
   const rccl::Motion first_above = microbo.move(above[0], after_present);
   wait(microbo, first_above.start());
   const double presented_s = good ? watch.ended_s("puma", present) : 0.0;
