@@ -1,16 +1,22 @@
-// The KDL oracle for URDF robots: a KDL chain built from a URDF file through urdfdom as
-// kdl_parser builds it (each joint about its axis in the joint frame, each segment's frame the
-// joint origin, each link's inertial as a RigidBodyInertia), independently of rccx's reader.
+// Shared by the URDF tests: random joint values within limits, and the KDL oracle for URDF robots:
+// a KDL chain built from a URDF file through urdfdom as kdl_parser builds it (each joint about its
+// axis in the joint frame, each segment's frame the joint origin, each link's inertial as a
+// RigidBodyInertia), independently of rccx's reader.
 #pragma once
 
 #include <urdf_parser/urdf_parser.h>
 
+#include <cmath>
 #include <kdl/chain.hpp>
 #include <kdl/frames.hpp>
 #include <kdl/rigidbodyinertia.hpp>
 #include <kdl/rotationalinertia.hpp>
+#include <random>
 #include <string>
 #include <vector>
+
+#include "rccx/kinematics/robot_model.hpp"
+#include "rccx/math/units.hpp"
 
 namespace rccx::test {
 
@@ -52,6 +58,17 @@ inline KDL::Chain kdl_chain_from_urdf(const urdf::ModelInterface& model, const s
     chain.addSegment(KDL::Segment((*it)->name, joint, origin, kdl_inertia(**it)));
   }
   return chain;
+}
+
+/// Joint values drawn uniformly within each joint's limits (a continuous joint within a turn).
+inline kin::JointVector random_within_limits(const kin::RobotModel& m, std::mt19937_64& rng) {
+  kin::JointVector q(m.dof());
+  for (std::size_t i = 0; i < m.dof(); ++i) {
+    const double lo = std::isfinite(m.joints[i].lower) ? m.joints[i].lower : -math::kPi;
+    const double hi = std::isfinite(m.joints[i].upper) ? m.joints[i].upper : math::kPi;
+    q[i] = std::uniform_real_distribution<double>(lo, hi)(rng);
+  }
+  return q;
 }
 
 }  // namespace rccx::test

@@ -54,15 +54,7 @@ constexpr Case kShippedUrdfs[] = {{"ur5e.urdf", "base_link", "tool0"},
                                   {"panda.urdf", "panda_link0", "panda_link8"},
                                   {"puma560.urdf", "base_link", "flange"}};
 
-kin::JointVector random_within_limits(const kin::RobotModel& m, std::mt19937_64& rng) {
-  kin::JointVector q(m.dof());
-  for (std::size_t i = 0; i < m.dof(); ++i) {
-    const double lo = std::isfinite(m.joints[i].lower) ? m.joints[i].lower : -math::kPi;
-    const double hi = std::isfinite(m.joints[i].upper) ? m.joints[i].upper : math::kPi;
-    q[i] = std::uniform_real_distribution<double>(lo, hi)(rng);
-  }
-  return q;
-}
+using test::random_within_limits;
 
 KDL::JntArray kdl_joints(const kin::JointVector& q) {
   KDL::JntArray jq(static_cast<unsigned>(q.size()));

@@ -61,15 +61,7 @@ kin::IkOptions ik(std::optional<kin::Configuration> configuration,
   return o;
 }
 
-kin::JointVector random_within_limits(const kin::RobotModel& m, std::mt19937_64& rng) {
-  kin::JointVector q(m.dof());
-  for (std::size_t i = 0; i < m.dof(); ++i) {
-    const double lo = std::isfinite(m.joints[i].lower) ? m.joints[i].lower : -math::kPi;
-    const double hi = std::isfinite(m.joints[i].upper) ? m.joints[i].upper : math::kPi;
-    q[i] = std::uniform_real_distribution<double>(lo, hi)(rng);
-  }
-  return q;
-}
+using rccx::test::random_within_limits;
 
 struct Case {
   const char* file;
