@@ -10,14 +10,16 @@ foreach(var SCRIPT BUILD CSV PADS)
   endif()
 endforeach()
 
-# A loaded machine's stalls are not lost links here: the detection time is generous. Once more,
-# said, after an attempt before the third that failed on a state that came late (a collision
-# stop with the allowance its age adds, or a peer silent past the detection time). A serve's control cycle that
-# overran its period (RTC ends that robot's control; a debug build's serve did, now and then,
-# even on a quiet machine) is run again up to the third attempt, and when the third overran too
-# the test is skipped, saying so (ctest's SKIP_REGULAR_EXPRESSION "rccx-skip:"): the machine did
-# not give the serves their real time, nothing of the program was judged. Any other failure fails.
+# A loaded machine's stalls are not lost links here: the detection time is generous. What a
+# machine that does not give the serves their real time ends a run with is run again, up to the
+# third attempt: a serve's control cycle that overran its period (RTC ends that robot's control;
+# a debug build's serve did, now and then, even on a quiet machine), a state that came late (a
+# collision stop with the allowance its age adds) or a peer silent past the detection time (a CI
+# machine's stalls reached 7 ms in a 7 ms period). When the third attempt ends so too, the test is
+# skipped, saying so (ctest's SKIP_REGULAR_EXPRESSION "rccx-skip:"): nothing of the program was
+# judged. Any other failure fails, at any attempt.
 set(overrun "did not hand Chg over within its period|was still running at the next tick")
+set(late "another process's, its state [0-9]+ ms old|is silent for [0-9]+ ms")
 foreach(attempt 1 2 3)
   file(REMOVE "${CSV}")
   execute_process(COMMAND "${SCRIPT}" --build "${BUILD}" --detection 250ms -- --csv "${CSV}"
@@ -30,19 +32,18 @@ foreach(attempt 1 2 3)
     break()
   endif()
   if("${out}${err}" MATCHES "${overrun}")
-    if(attempt EQUAL 3)
-      message(STATUS "rccx-skip: each of the 3 attempts was ended by a serve's overrun (above): "
-                     "this machine did not give the serves their real time; nothing judged")
-      return()
-    endif()
-    message(STATUS "attempt ${attempt} was ended by a serve's overrun (above); once more")
-    continue()
+    set(why "a serve's overrun")
+  elseif("${out}${err}" MATCHES "${late}")
+    set(why "a late state (\"${CMAKE_MATCH_0}\")")
+  else()
+    break()  # not the machine's load: judged below
   endif()
-  if(attempt LESS 3 AND "${out}${err}" MATCHES "another process's, its state [0-9]+ ms old|is silent for [0-9]+ ms")
-    message(STATUS "attempt ${attempt} failed on a late state (above); once more")
-    continue()
+  if(attempt EQUAL 3)
+    message(STATUS "rccx-skip: each of the 3 attempts was ended by the machine's load (the last by "
+                   "${why}, above): this machine did not give the serves their real time; nothing judged")
+    return()
   endif()
-  break()
+  message(STATUS "attempt ${attempt} was ended by ${why} (above); once more")
 endforeach()
 if(NOT rc STREQUAL "0")
   message(FATAL_ERROR "demo-distributed exited with ${rc}")
