@@ -26,7 +26,8 @@ unset PYTHONPATH PIP_ROOT PIP_PREFIX PIP_TARGET PIP_USER VIRTUAL_ENV
 skip() { echo "rccx-skip: $*"; exit 0; }
 command -v git > /dev/null || skip "git not found (the test copies the checkout's files)"
 git -C "$source" rev-parse --git-dir > /dev/null 2>&1 || skip "$source is not a git checkout"
-$python -c "import ensurepip, venv" 2> /dev/null || skip "no venv module (apt-get install python3-venv)"
+$python -c "import ensurepip, venv" 2> /dev/null ||
+  skip "no venv module (apt-get install python3-venv)"
 for module in pip setuptools wheel numpy pybind11; do
   $python -c "import $module" 2> /dev/null ||
     skip "$python has no $module (scripts/install-deps installs python3-$module)"
@@ -46,7 +47,8 @@ block() {
 run_block() {
   local name=$1
   shift
-  (cd "$work/clone" && env "$@" bash -euo pipefail <<< "$(block "$name")") > "$work/$name.log" 2>&1 ||
+  (cd "$work/clone" && env "$@" bash -euo pipefail <<< "$(block "$name")") \
+    > "$work/$name.log" 2>&1 ||
     { tail -60 "$work/$name.log"; echo "README block $name failed" >&2; exit 1; }
   echo "$name: installed"
 }
@@ -96,7 +98,8 @@ PY
 mkdir "$work/clone"
 git -C "$source" ls-files -z --cached --others --exclude-standard |
   (cd "$source" && tar -cf - --null --no-recursion -T - 2> /dev/null) | tar -xf - -C "$work/clone"
-[[ -f $work/clone/pyproject.toml && -f $work/clone/setup.py ]] || { echo "the copy has no pyproject.toml / setup.py" >&2; exit 1; }
+[[ -f $work/clone/pyproject.toml && -f $work/clone/setup.py ]] ||
+  { echo "the copy has no pyproject.toml / setup.py" >&2; exit 1; }
 
 # 1. A venv seeing Debian's packages; the README's lines.
 run_block pip-venv
@@ -106,15 +109,17 @@ check "$("$venv_python" -c 'import sysconfig; print(sysconfig.get_path("platlib"
 
 # 2. Debian's pip without a venv, as root (PEP 668's flag), into a temporary root.
 run_block pip-root PIP_ROOT="$work/root"
-root_dir=$(find "$work/root" -type f -name __init__.py -path '*/rccx/__init__.py' -printf '%h\n' | head -1)
-[[ -n $root_dir ]] || { echo "pip-root installed no rccx/__init__.py under $work/root" >&2; exit 1; }
+root_dir=$(find "$work/root" -type f -path '*/rccx/__init__.py' -printf '%h\n' | head -1)
+[[ -n $root_dir ]] ||
+  { echo "pip-root installed no rccx/__init__.py under $work/root" >&2; exit 1; }
 check "$(dirname "$root_dir")" "$python" PYTHONPATH="$(dirname "$root_dir")"
 
 # 3. cmake --install of the build under test: the package beside the libraries.
 cmake --install "$build" --prefix "$work/prefix" > "$work/cmake-install.log" 2>&1 ||
   { tail -30 "$work/cmake-install.log"; exit 1; }
-prefix_dir=$(find "$work/prefix" -type f -name __init__.py -path '*/rccx/__init__.py' -printf '%h\n' | head -1)
-[[ -n $prefix_dir ]] || { echo "cmake --install put no rccx/__init__.py under the prefix" >&2; exit 1; }
+prefix_dir=$(find "$work/prefix" -type f -path '*/rccx/__init__.py' -printf '%h\n' | head -1)
+[[ -n $prefix_dir ]] ||
+  { echo "cmake --install put no rccx/__init__.py under the prefix" >&2; exit 1; }
 ls "$prefix_dir"/_rccx*.so "$prefix_dir"/py.typed "$prefix_dir"/__init__.pyi > /dev/null
 preload_env=()
 [[ -n $preload ]] && preload_env=(LD_PRELOAD="$preload" ASAN_OPTIONS=detect_leaks=0)

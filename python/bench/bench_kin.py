@@ -114,7 +114,8 @@ def fk_batch(ctx, k):
     theirs = kdl_program()
     difference = float(np.max(np.abs(ours - theirs)))
     if not difference <= TOLERANCE:
-        raise SystemExit(f"bench_kin: rccx and PyKDL poses differ by {difference:g} > {TOLERANCE:g}")
+        raise SystemExit(f"bench_kin: rccx and PyKDL poses differ by {difference:g} "
+                         f"> {TOLERANCE:g}")
 
     rccx_t = ctx.time_ns(lambda: k.forward(Q))
     kdl_calls_t = ctx.time_ns(kdl_calls, repetitions=min(ctx.repetitions, 5))

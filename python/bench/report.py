@@ -22,7 +22,8 @@ def ns(v):
 
 
 def timing(t):
-    return f"{ns(t['median_ns'])} (min {ns(t['min_ns'])}, max {ns(t['max_ns'])}, n={t['repetitions']})"
+    return (f"{ns(t['median_ns'])} (min {ns(t['min_ns'])}, max {ns(t['max_ns'])}, "
+            f"n={t['repetitions']})")
 
 
 def print_kin(cases):
@@ -50,7 +51,8 @@ def print_kin(cases):
         print("| | ms in all | ns per pose | / rccx | CPU ns per pose | / rccx (CPU) |")
         print("|---|---:|---:|---:|---:|---:|")
         rows = [("rccx: k.forward(Q), one call", batch["rccx_one_call"]),
-                ("PyKDL: a Python loop, the same input and output", batch["pykdl_loop_with_conversions"]),
+                ("PyKDL: a Python loop, the same input and output",
+                 batch["pykdl_loop_with_conversions"]),
                 ("PyKDL: the JntToCart calls alone", batch["pykdl_loop_calls"])]
         base = batch["rccx_one_call"]
         for text, t in rows:

@@ -6,11 +6,11 @@ Usage: run.py --cpp bench-results/python-cpp.json --out bench-results/python.jso
 
 --cpp is Google Benchmark's JSON of the C++ peers, run by the same make target just before
 (rccx_bench --benchmark_filter=... --benchmark_repetitions=N). Each module gets a Context (the
-C++ medians by name, wall clock and CPU, the repetition count, a timer) and returns {"cases": {name: {...}},
-"goals": [{"text", "value", "value_cpu", "unit", "goal", "op"}]}; scripts in this directory share the timing
-rules below. A new comparison is a new bench_<topic>.py with a run(ctx) function (a Python
-`move()` to its first setpoint against C++'s belongs in bench_move.py, its C++ peer added to the
-Makefile's BENCH_PYTHON_CPP filter).
+C++ medians by name, wall clock and CPU, the repetition count, a timer) and returns
+{"cases": {name: {...}}, "goals": [{"text", "value", "value_cpu", "unit", "goal", "op"}],
+"notes": [...]}; the modules share the timing rules below. A new comparison is a new
+bench_<topic>.py with a run(ctx) function (a Python `move()` to its first setpoint against C++'s
+belongs in bench_move.py, its C++ peer added to the Makefile's BENCH_PYTHON_CPP filter).
 
 Timing: time.perf_counter_ns around a block of calls, several repetitions, the median reported
 (and the minimum and maximum beside it); the thread's CPU time beside it, as Google Benchmark
