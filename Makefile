@@ -80,6 +80,24 @@ bench: build-release
 	  --benchmark_filter=-BM_CellCycle
 	@python3 scripts/bench-report bench-results/kinematics.json
 
+# The Python bindings against the same work in C++ and in PyKDL (python/bench/, docs/PYTHON.md
+# "Speed"): the C++ peers (BENCH_PYTHON_CPP, a benchmark filter) and python/bench/run.py in the
+# same run, both into bench-results/, then the ratios and goals. The interpreter is the one the
+# module was built for (the build's Python3_EXECUTABLE).
+BENCH_PYTHON_CPP ?= ^BM_Puma560FK$$|^BM_KdlPuma560FK$$
+.PHONY: bench-python
+bench-python: deps $(RELEASE_DIR)/CMakeCache.txt
+	$(CMAKE) --build $(RELEASE_DIR) -j$(JOBS) --target rccx_bench rccx_python
+	@mkdir -p bench-results
+	$(RELEASE_DIR)/bench/rccx_bench --benchmark_filter='$(BENCH_PYTHON_CPP)' \
+	  --benchmark_out=bench-results/python-cpp.json --benchmark_out_format=json \
+	  --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
+	py=$$(sed -n 's/^Python3_EXECUTABLE:[A-Z]*=//p' $(RELEASE_DIR)/CMakeCache.txt); \
+	  test -n "$$py" || { echo "bench-python: $(RELEASE_DIR) has no Python module (RCCX_PYTHON)" >&2; exit 1; }; \
+	  PYTHONPATH=$(RELEASE_DIR)/python "$$py" python/bench/run.py --cpp bench-results/python-cpp.json \
+	    --out bench-results/python.json && \
+	  "$$py" python/bench/report.py bench-results/python.json
+
 # The workcell's cycle (bench/cell_bench.cpp): N robots on one clock, two tasks and one
 # thread, ideal servos and the PUMA plant; a fixed number of ticks a case, a few minutes in all.
 bench-cell: build-release
