@@ -225,6 +225,68 @@ TEST(CellRuntime, TheMicroboFollowsAFrameThePumaMoves) {
   EXPECT_LT(worst_m, 1e-3) << "commanded tool points apart by up to " << worst_m * 1e3 << " mm";
 }
 
+// A motion to a goal on another robot's frame that waits for that robot's motion is judged where
+// the frame will be when it starts, not where it is when queued: out of the Microbo's reach while
+// the PUMA stands away, reached once the PUMA has brought it back (the circuit board's probes,
+// queued while the board was still on its way across hosts, were refused). Still out of reach
+// when it starts, the motion fails then, saying why, and the Microbo does not move; queued to
+// start at once, it is refused at once as before.
+TEST(CellRuntime, AGatedMotionToAMovingGoalIsJudgedWhenItStarts) {
+  const auto c = cell::Cell::load(kCvarl);
+  c->start();
+  rccl::Manipulator& puma = c->robot("puma");
+  rccl::Manipulator& microbo = c->robot("microbo");
+  const math::Vec3 p0 = kAbove + math::Vec3{-0.05, 0.0, 0.0};
+  const math::Vec3 away = p0 + math::Vec3{-0.10, -0.30, 0.0};  // the goal 150 mm on: out of reach
+  puma.set_velocity(0.05, 0.5);  // joint moves slow enough near the other arm
+  microbo.set_velocity(0.05, 0.5);
+  puma.move(world_position(*c, "puma", "P0", down_at(p0)));
+  microbo.move(world_position(*c, "microbo", "M0", down_at(p0 + math::Vec3{0.15, 0.0, 0.0})));
+  ASSERT_EQ(microbo.waitfor(rccl::Manipulator::completed(), 30s), rccl::WaitResult::reached)
+      << failures_of(microbo);
+  puma.move(world_position(*c, "puma", "AWAY", down_at(away)));
+  ASSERT_EQ(puma.waitfor(rccl::Manipulator::completed(), 30s), rccl::WaitResult::reached)
+      << failures_of(puma);
+
+  // T6 TOOL = BASE_INV(microbo) PUMA_TOOL GRASP: 150 mm along the PUMA's tool x.
+  const auto t6 = rccl::t6();
+  const auto tool = rccl::constant("TOOL", c->model().find_robot("microbo")->tool.value());
+  const auto puma_tool = c->in_base_of("microbo", c->tool_frame("puma"));
+  const auto grasp = rccl::constant("GRASP", math::Transform::translation(0.15, 0.0, 0.0));
+  const auto on_puma = rccl::Position::make("ON_PUMA", {t6, tool}, {puma_tool, grasp}, tool);
+  const rtc::How h = c->session("microbo").how();
+  const math::Transform goal_now = on_puma->t6_at({h.time_s, h.sample, nullptr});
+  ASSERT_FALSE(microbo.kinematics().inverse(goal_now))
+      << "the test's premise: the goal is out of the Microbo's reach while the PUMA is away";
+  EXPECT_THROW(microbo.move(on_puma), rccl::MotionError) << "starting at once: refused at once";
+
+  // Gated on the PUMA's next motion: queued, and judged when it starts.
+  const kin::JointVector q_before = c->session("microbo").how().q();
+  const rccl::Motion stay = puma.dwell(0.5);
+  rccl::Motion m;
+  ASSERT_NO_THROW(m = microbo.move(on_puma, c->after("puma", stay.end())));
+  EXPECT_EQ(microbo.waitfor(m.end(), 30s), rccl::WaitResult::failed);
+  ASSERT_FALSE(microbo.failures().empty());
+  EXPECT_NE(microbo.failures().back().message().find("ON_PUMA cannot be reached"),
+            std::string::npos)
+      << microbo.failures().back().message();
+  // Measured: the servo's jitter is a few 1e-5 rad; the goal lies over 150 mm away.
+  const math::Vec3 moved = tool_point(*c, "microbo", c->session("microbo").how().q()) -
+                           tool_point(*c, "microbo", q_before);
+  EXPECT_LT(moved.norm(), 0.5e-3) << "the Microbo's tool moved " << moved.norm() * 1e3 << " mm";
+
+  const rccl::Motion back = puma.move(world_position(*c, "puma", "BACK", down_at(p0)));
+  ASSERT_NO_THROW(m = microbo.move(on_puma, c->after("puma", back.end())));
+  ASSERT_EQ(microbo.waitfor(m.end(), 30s), rccl::WaitResult::reached) << failures_of(microbo);
+  c->wait_for(100ms);
+  const math::Vec3 tip = tool_point(*c, "microbo", c->session("microbo").how().q());
+  const math::Vec3 want =
+      (c->tool_sample("puma").pose * math::Transform::translation(0.15, 0, 0)).p;
+  EXPECT_LT((tip - want).norm(), 1e-3) << "the Microbo's tool " << (tip - want).norm() * 1e3
+                                       << " mm from the point on the PUMA's tool";
+  EXPECT_TRUE(puma.failures().empty()) << failures_of(puma);
+}
+
 // A Cartesian line onto a frame another robot moves is straight relative to that frame: the
 // Microbo, held 20 mm above what the PUMA carries, is lowered onto it while the PUMA carries it
 // along y at 20 mm/s (issue 28: the line started where the frame had been when it was

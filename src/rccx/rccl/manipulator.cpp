@@ -193,7 +193,7 @@ void Manipulator::check_joint_goal(const Position& p) {
   queued_configuration_ = kinematics_->configuration_of(q);
 }
 
-std::int16_t Manipulator::check_reachable(const Position& p) {
+std::int16_t Manipulator::check_reachable(const Position& p, bool starts_later) {
   if (p.in_joints()) {
     check_joint_goal(p);
     return -1;
@@ -205,7 +205,7 @@ std::int16_t Manipulator::check_reachable(const Position& p) {
   const char* when = p.moves() ? " (its goal as it is now)" : "";
   if (names.empty()) {
     const kin::IkResult r = kinematics_->inverse(t6);
-    if (!r) {
+    if (!r && !starts_later) {
       throw MotionError(fmt::format("position {} cannot be reached{}: {}", p.name(), when,
                                     kin::describe(r.status)));
     }
@@ -241,6 +241,7 @@ std::int16_t Manipulator::check_reachable(const Position& p) {
       return static_cast<std::int16_t>(n.configuration.index);
     }
   }
+  if (starts_later) return -1;
   throw_unreachable(p, t6, when, c, asked, r.status);
 }
 
@@ -334,7 +335,8 @@ Motion Manipulator::move(const PositionPtr& position, const StartWhen& when) {
         "simulate it on the MuJoCo plant (\"plant\": \"mujoco\" in its robot file)",
         kinematics_->model().name));
   }
-  const std::int16_t configuration = check_reachable(*position);
+  const std::int16_t configuration =
+      check_reachable(*position, position->moves() && (!when.after.empty() || when.together));
   MotionRequest r;
   r.kind = RequestKind::move;
   r.position = position.get();

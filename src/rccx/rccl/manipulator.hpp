@@ -104,7 +104,10 @@ class Manipulator : public Arm {
   /// one asked for with set_configuration() in joint mode, else the one the arm will be in when
   /// the motion starts (a Cartesian line keeps it) - saying which configurations do reach it.
   /// A joint move with no configuration asked whose goal the present configuration cannot
-  /// reach moves into the configuration whose solution lies nearest the arm's joints.
+  /// reach moves into the configuration whose solution lies nearest the arm's joints. A
+  /// moving goal (functional transforms) whose motion waits for events (`when`) is refused
+  /// now only when the check does not depend on where it is: out of reach now, it is judged
+  /// when the motion starts, which then fails with the reason if it is still out of reach.
   /// `when`: the motion starts only once those events (other robots' motions, see
   /// cell::Cell::event) have happened, or with the others of a rendezvous; it then starts from rest
   /// (the motion before it comes to rest first unless its gates are open by then) and is cancelled
@@ -201,7 +204,10 @@ class Manipulator : public Arm {
   void drain();
   /// Refuses (MotionError) a goal the motion cannot reach. Returns the configuration a joint
   /// move with none asked must take (the present one cannot reach the goal), else -1.
-  std::int16_t check_reachable(const Position& p);
+  /// `starts_later`: a moving goal whose motion waits for other robots' events; where it is now
+  /// says little about where it will be when the motion starts, so a goal out of reach now is
+  /// left to the generator, which judges it at the start (the motion fails then, saying why).
+  std::int16_t check_reachable(const Position& p, bool starts_later);
   /// check_reachable for a goal in joints: their number and limits.
   void check_joint_goal(const Position& p);
   /// The MotionError for a goal `t6` no solution in configuration `c` reaches (`status`: why),
