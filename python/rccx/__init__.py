@@ -8,3 +8,11 @@ from ._rccx import RobotFileError, UnreachableError
 from . import kin
 
 __all__ = ["kin", "RobotFileError", "UnreachableError"]
+
+# Run logs, the plots of `rccx plot`, the position database (rccx.plot imports Matplotlib only
+# when it draws).
+from ._rccx import DatabaseBusy, DatabaseError, InvalidTransform, RunLogError
+from . import db, log, plot
+
+__all__ += ["db", "log", "plot", "DatabaseBusy", "DatabaseError", "InvalidTransform",
+            "RunLogError"]

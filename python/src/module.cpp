@@ -9,6 +9,11 @@
 #include "rccx/kinematics/robot_model.hpp"
 
 namespace py = pybind11;
+
+// rccx.log, rccx.plot, rccx.db (data_module.cpp).
+namespace rccx::python {
+void bind_data(py::module_& m);
+}
 using rccx::python::KinematicsObject;
 
 namespace {
@@ -123,4 +128,6 @@ PYBIND11_MODULE(_rccx, m) {
           py::arg("tip_link") = py::none(),
           "A robot from a URDF: the chain from base_link (default: the tree's root) to tip_link "
           "(default: the only leaf). Raises FileNotFoundError, rccx.RobotFileError.");
+
+  rccx::python::bind_data(m);  // rccx.log, rccx.plot, rccx.db
 }

@@ -17,13 +17,7 @@ namespace {
 constexpr std::array<const char*, 8> kColours = {"#d08020", "#2070c0", "#30a030", "#b040b0",
                                                  "#c03030", "#20a0a0", "#909020", "#6050d0"};
 
-struct Series {
-  std::vector<double> x, y;
-  std::string colour;
-  std::string label;
-  bool dashed = false;
-  double width = 1.4;
-};
+using Series = PlotSeries;
 
 std::string escape(std::string_view s) {
   std::string out;
@@ -63,8 +57,12 @@ struct Box {
 
 /// One panel: a frame, axes with ticks, the series, a legend. `equal`: the same scale on both
 /// axes (a path in a plane).
-void panel(std::string& svg, const Box& b, const std::string& title, const std::string& xlabel,
-           const std::string& ylabel, const std::vector<Series>& series, bool equal = false) {
+void panel(std::string& svg, const Box& b, const PlotPanel& p) {
+  const std::string& title = p.title;
+  const std::string& xlabel = p.xlabel;
+  const std::string& ylabel = p.ylabel;
+  const std::vector<Series>& series = p.series;
+  const bool equal = p.equal_axes;
   double x0 = std::numeric_limits<double>::infinity(), x1 = -x0, y0 = x0, y1 = -x0;
   for (const Series& s : series) {
     for (double v : s.x) x0 = std::min(x0, v), x1 = std::max(x1, v);
@@ -177,7 +175,7 @@ std::vector<double> path_errors_m(const RunLog& log, const kin::RobotModel& mode
   return errors;
 }
 
-std::string plot_svg(const RunLog& log, const kin::RobotModel& model, const std::string& title) {
+RunPlot run_plot(const RunLog& log, const kin::RobotModel& model) {
   const std::vector<double> errors_m = path_errors_m(log, model);  // checks the joints
   const auto kinematics = kin::make_kinematics(model);
   const std::size_t n = log.rows.size();
@@ -236,16 +234,34 @@ std::string plot_svg(const RunLog& log, const kin::RobotModel& model, const std:
   // Speed along the path and the path error.
   Series speed_c{t, {}, "#2070c0", "commanded"}, speed_m{t, {}, "#d08020", "measured", true};
   Series error{t, {}, "#c03030", "measured tool from the commanded path"};
-  double worst = 0.0;
+  double worst_m = 0.0;
   for (std::size_t i = 0; i < n; ++i) {
     const double dt = i == 0 ? 0.0 : log.rows[i].t_s - log.rows[i - 1].t_s;
     speed_c.y.push_back(i == 0 ? 0.0 : (pc[i] - pc[i - 1]).norm() / dt * 1e3);
     speed_m.y.push_back(i == 0 ? 0.0 : (pm[i] - pm[i - 1]).norm() / dt * 1e3);
-    const double e = errors_m[i] * 1e3;
-    error.y.push_back(e);
-    worst = std::max(worst, e);
+    error.y.push_back(errors_m[i] * 1e3);
+    worst_m = std::max(worst_m, errors_m[i]);
   }
 
+  RunPlot plot;
+  plot.robot_title = model.title.empty() ? model.name : model.title;
+  plot.samples = n;
+  plot.duration_s = t.back();
+  plot.worst_path_error_m = worst_m;
+  plot.panels = {
+      {"Joints (measured solid, commanded dashed)", "t s", "deg / mm", std::move(joints)},
+      {fmt::format("Tool path in the {}-{} plane", names[u], names[v]),
+       fmt::format("{} mm", names[u]),
+       fmt::format("{} mm", names[v]),
+       {std::move(path_c), std::move(path_m)},
+       true},
+      {"Speed along the path", "t s", "mm/s", {std::move(speed_c), std::move(speed_m)}},
+      {"Path error (measured tool from the commanded path)", "t s", "mm", {std::move(error)}}};
+  return plot;
+}
+
+std::string plot_svg(const RunLog& log, const kin::RobotModel& model, const std::string& title) {
+  const RunPlot plot = run_plot(log, model);
   constexpr double W = 1200, H = 900;
   std::string svg = fmt::format(
       "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{0}\" height=\"{1}\" viewBox=\"0 0 {0} "
@@ -256,16 +272,12 @@ std::string plot_svg(const RunLog& log, const kin::RobotModel& model, const std:
       "<text x=\"{2}\" y=\"24\" class=\"title\" style=\"font-size:17px\">{3}</text>\n"
       "<text x=\"{2}\" y=\"42\" class=\"tick\">{4}: {5} samples, {6:.2f} s; worst path error "
       "{7:.3f} mm (measured tool from the commanded path, every sample)</text>\n",
-      W, H, W / 2, escape(title), escape(model.title.empty() ? model.name : model.title), n,
-      t.back(), worst);
+      W, H, W / 2, escape(title), escape(plot.robot_title), plot.samples, plot.duration_s,
+      plot.worst_path_error_m * 1e3);
   const double top = 50, ph = (H - top) / 2, pw = W / 2;
-  panel(svg, {0, top, pw, ph}, "Joints (measured solid, commanded dashed)", "t s", "deg / mm",
-        joints);
-  panel(svg, {pw, top, pw, ph}, fmt::format("Tool path in the {}-{} plane", names[u], names[v]),
-        fmt::format("{} mm", names[u]), fmt::format("{} mm", names[v]), {path_c, path_m}, true);
-  panel(svg, {0, top + ph, pw, ph}, "Speed along the path", "t s", "mm/s", {speed_c, speed_m});
-  panel(svg, {pw, top + ph, pw, ph}, "Path error (measured tool from the commanded path)", "t s",
-        "mm", {error});
+  const Box boxes[4] = {
+      {0, top, pw, ph}, {pw, top, pw, ph}, {0, top + ph, pw, ph}, {pw, top + ph, pw, ph}};
+  for (std::size_t k = 0; k < plot.panels.size(); ++k) panel(svg, boxes[k], plot.panels[k]);
   svg += "</svg>\n";
   return svg;
 }
