@@ -11,6 +11,11 @@
 namespace py = pybind11;
 using rccx::python::KinematicsObject;
 
+// Position equations and robots (arm_module.cpp).
+namespace rccx::python {
+void bind_rccl(py::module_& m);
+}
+
 namespace {
 
 /// Registers a C++ exception type as a Python exception of module rccx deriving from `base`.
@@ -123,4 +128,7 @@ PYBIND11_MODULE(_rccx, m) {
           py::arg("tip_link") = py::none(),
           "A robot from a URDF: the chain from base_link (default: the tree's root) to tip_link "
           "(default: the only leaf). Raises FileNotFoundError, rccx.RobotFileError.");
+
+  // Position equations, robots and cells (arm_module.cpp); after kin: Arm.kinematics returns one.
+  rccx::python::bind_rccl(m);
 }
