@@ -16,3 +16,13 @@ from . import db, log, plot
 
 __all__ += ["db", "log", "plot", "DatabaseBusy", "DatabaseError", "InvalidTransform",
             "RunLogError"]
+# Position equations and robots (docs/PYTHON.md, "Position equations" and "Driving a robot").
+from ._rccx import (Arm, Cell, CellFileError, EquationError, Event, Gate, LogError, Motion,
+                    MotionError, Position, Robot, SessionError, Stream, Together, Transform, When,
+                    const, hold, joints, stream, t6)
+from .motion import Equation, Product, position
+
+__all__ += ["Arm", "Cell", "CellFileError", "Equation", "EquationError", "Event", "Gate",
+            "LogError", "Motion", "MotionError", "Position", "Product", "Robot", "SessionError",
+            "Stream", "Together", "Transform", "When", "const", "hold", "joints", "position",
+            "stream", "t6"]

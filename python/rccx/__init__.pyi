@@ -27,3 +27,17 @@ class InvalidTransform(DatabaseError, ValueError):
 
 __all__ += ["db", "log", "plot", "DatabaseBusy", "DatabaseError", "InvalidTransform",
             "RunLogError"]
+# Position equations and robots (rccx/motion.pyi).
+from .motion import (Arm as Arm, Cell as Cell, CellFileError as CellFileError,
+                     Equation as Equation, EquationError as EquationError, Event as Event,
+                     Gate as Gate, LogError as LogError, Motion as Motion,
+                     MotionError as MotionError, Position as Position, Product as Product,
+                     Robot as Robot, SessionError as SessionError, Stream as Stream,
+                     Together as Together, Transform as Transform, When as When, const as const,
+                     hold as hold, joints as joints, position as position, stream as stream,
+                     t6 as t6)
+
+__all__ += ["Arm", "Cell", "CellFileError", "Equation", "EquationError", "Event", "Gate",
+            "LogError", "Motion", "MotionError", "Position", "Product", "Robot", "SessionError",
+            "Stream", "Together", "Transform", "When", "const", "hold", "joints", "position",
+            "stream", "t6"]

@@ -16,6 +16,11 @@ void bind_data(py::module_& m);
 }
 using rccx::python::KinematicsObject;
 
+// Position equations and robots (arm_module.cpp).
+namespace rccx::python {
+void bind_rccl(py::module_& m);
+}
+
 namespace {
 
 /// Registers a C++ exception type as a Python exception of module rccx deriving from `base`.
@@ -130,4 +135,6 @@ PYBIND11_MODULE(_rccx, m) {
           "(default: the only leaf). Raises FileNotFoundError, rccx.RobotFileError.");
 
   rccx::python::bind_data(m);  // rccx.log, rccx.plot, rccx.db
+  // Position equations, robots and cells (arm_module.cpp); after kin: Arm.kinematics returns one.
+  rccx::python::bind_rccl(m);
 }

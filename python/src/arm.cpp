@@ -1,0 +1,520 @@
+// Driving robots from Python: rccl::Manipulator's calls with the GIL released and the owner's
+// planning lock taken, waits in slices that look for Ctrl-C, C++ errors left to carry rccx's
+// messages (MotionError, SessionError ... are Python exceptions, see arm_module.cpp).
+#include "arm.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <utility>
+
+#include "rccl.hpp"
+#include "rccx/cell/cell_model.hpp"
+#include "rccx/io/signals.hpp"
+#include "rccx/kinematics/robot_model.hpp"
+
+namespace rccx::python {
+
+namespace {
+
+using std::chrono::nanoseconds;
+
+rtc::ClockKind clock_of(const std::string& clock) {
+  if (clock == "simulated") return rtc::ClockKind::simulated;
+  if (clock == "real_time" || clock == "real-time" || clock == "real") {
+    return rtc::ClockKind::real_time;
+  }
+  raise_value_error(fmt::format("clock must be \"simulated\" or \"real_time\", got \"{}\"", clock));
+}
+
+nanoseconds seconds_to_ns(double s, const char* what) {
+  if (!std::isfinite(s) || s < 0.0 || s > 1e9) {
+    raise_value_error(fmt::format("{} must be a finite number of seconds >= 0, got {}", what, s));
+  }
+  return nanoseconds(std::llround(s * 1e9));
+}
+
+std::string termination_text(const rtc::Termination& t) {
+  std::string s = fmt::format("{}: {}", rtc::to_string(t.code), rtc::describe(t.code));
+  if (!t.message_view().empty()) s += fmt::format(" ({})", t.message_view());
+  if (!t.detail_view().empty()) s += fmt::format(" [{}]", t.detail_view());
+  return s;
+}
+
+std::uint8_t axis_of(const py::object& axis) {
+  if (py::isinstance<py::str>(axis)) {
+    const auto name = axis.cast<std::string>();
+    for (std::size_t i = 0; i < rccl::kForceAxisNames.size(); ++i) {
+      if (rccl::kForceAxisNames[i] == name) return static_cast<std::uint8_t>(i);
+    }
+  } else if (py::isinstance<py::int_>(axis)) {
+    const auto i = axis.cast<long>();
+    if (i >= 0 && i < 6) return static_cast<std::uint8_t>(i);
+  }
+  raise_value_error(fmt::format(
+      "a force axis is one of \"fx\" \"fy\" \"fz\" \"tx\" \"ty\" \"tz\" or 0 .. 5, got {}",
+      py::repr(axis).cast<std::string>()));
+}
+
+std::array<double, 6> six(const std::optional<InArray>& a, const char* what) {
+  std::array<double, 6> out{};
+  if (!a) return out;
+  if (ndim(*a) != 1 || extent(*a, 0) != 6) {
+    raise_value_error(
+        fmt::format("{} must have shape (6,) (fx fy fz in N, tx ty tz in N m), got "
+                    "shape {}",
+                    what, shape_text(*a)));
+  }
+  std::copy(a->data(), a->data() + 6, out.begin());
+  return out;
+}
+
+/// A slice of a wait: at least kWaitSlice and two periods, a whole number of periods (a
+/// simulated wait_for runs whole periods from now: slices that are not would lose time).
+nanoseconds slice_of(nanoseconds period) {
+  const nanoseconds p = std::max(period, nanoseconds(1));
+  const auto n = std::max<std::int64_t>(2, (kWaitSlice.count() + p.count() - 1) / p.count());
+  return p * n;
+}
+
+constexpr nanoseconds kForever = std::chrono::hours(24 * 365);
+
+}  // namespace
+
+std::string EventObject::repr() const {
+  switch (event.kind) {
+    case rccl::Event::Kind::motion_start:
+      return fmt::format("<rccx.Event start of motion {}>", event.id);
+    case rccl::Event::Kind::motion_end:
+      return fmt::format("<rccx.Event end of motion {}>", event.id);
+    case rccl::Event::Kind::position_end:
+      return fmt::format("<rccx.Event end of every motion to {}>",
+                         position ? position->name() : std::string("?"));
+    case rccl::Event::Kind::completed:
+      break;
+  }
+  return "<rccx.Event completed>";
+}
+
+// --- ArmObject -------------------------------------------------------------------------------
+
+ArmObject::ArmObject(std::shared_ptr<Owner> owner, rccl::Manipulator& arm, std::string name)
+    : owner_(std::move(owner)), arm_(&arm), name_(std::move(name)) {}
+
+void ArmObject::check_open() const {
+  if (owner_->closed) throw rtc::SessionError(fmt::format("robot {} is closed", name_));
+}
+
+bool ArmObject::sliced_wait(Owner& owner, std::optional<double> timeout_s, nanoseconds period,
+                            const std::function<bool(nanoseconds)>& step) {
+  nanoseconds remaining = timeout_s ? seconds_to_ns(*timeout_s, "timeout") : kForever;
+  const nanoseconds slice = slice_of(period);
+  // Ctrl-C: Python's handler raised (no control running), or rccx's counted it (its handler
+  // stands in for Python's during control, and halted the arms).
+  const auto interrupted = [&owner] {
+    if (const std::uint32_t n = io::stop_count(); n != owner.stops_seen) {
+      owner.stops_seen = n;
+      PyErr_SetNone(PyExc_KeyboardInterrupt);
+      return true;
+    }
+    return PyErr_CheckSignals() != 0;
+  };
+  for (;;) {
+    const nanoseconds d = std::min(slice, remaining);
+    bool done = false;
+    if (!interrupted()) {
+      {
+        const ReleaseGil release;
+        const std::lock_guard lock(owner.planning);
+        if (owner.closed) throw rtc::SessionError("the robot is closed");
+        done = step(d);
+      }
+      remaining -= d;
+      if (!interrupted()) {
+        if (done) return true;
+        if (remaining <= nanoseconds(0)) return false;
+        continue;
+      }
+    }
+    // End control cleanly, then raise.
+    py::error_already_set raised;  // fetches KeyboardInterrupt
+    {
+      const ReleaseGil release;
+      const std::lock_guard lock(owner.planning);
+      if (!owner.closed && owner.interrupt) {
+        try {
+          owner.interrupt();
+        } catch (const std::exception&) {  // KeyboardInterrupt says more than this
+        }
+      }
+    }
+    throw raised;
+  }
+}
+
+void ArmObject::set_mode(const std::string& mode) {
+  rccl::Mode m{};
+  if (mode == "joint") {
+    m = rccl::Mode::joint;
+  } else if (mode == "cartesian") {
+    m = rccl::Mode::cartesian;
+  } else {
+    raise_value_error(fmt::format("mode must be \"joint\" or \"cartesian\", got \"{}\"", mode));
+  }
+  locked([&] { arm_->set_mode(m); });
+}
+
+std::string ArmObject::mode() const {
+  return std::string(rccl::to_string(locked([&] { return arm_->settings().mode; })));
+}
+
+void ArmObject::set_velocity(double translation_m_per_s, double rotation_rad_per_s) {
+  locked([&] { arm_->set_velocity(translation_m_per_s, rotation_rad_per_s); });
+}
+void ArmObject::set_segment_time(double seconds) {
+  locked([&] { arm_->set_segment_time(seconds); });
+}
+void ArmObject::set_transition_time(double seconds) {
+  locked([&] { arm_->set_transition_time(seconds); });
+}
+void ArmObject::set_configuration(const std::string& name) {
+  locked([&] { arm_->set_configuration(name); });
+}
+
+void ArmObject::set_guard(const std::optional<std::string>& kind, const py::object& axis,
+                          double threshold) {
+  rccl::ForceGuard g;
+  if (!kind || *kind == "none") {
+    g.kind = rccl::ForceGuard::Kind::none;
+  } else if (*kind == "along") {
+    g.kind = rccl::ForceGuard::Kind::along;
+    g.axis = axis_of(axis);
+  } else if (*kind == "magnitude") {
+    g.kind = rccl::ForceGuard::Kind::magnitude;
+  } else {
+    raise_value_error(
+        fmt::format("guard kind must be None, \"along\" or \"magnitude\", got \"{}\"", *kind));
+  }
+  g.threshold = threshold;
+  locked([&] { arm_->set_guard(g); });
+}
+
+void ArmObject::set_compliance(const std::vector<py::object>& axes,
+                               const std::optional<InArray>& force,
+                               const std::optional<InArray>& stiffness,
+                               const std::optional<InArray>& damping, double max_speed_m_per_s,
+                               double max_force_N) {
+  rccl::Compliance c;
+  for (const py::object& a : axes) c.axes |= static_cast<std::uint8_t>(1U << axis_of(a));
+  c.force = six(force, "force");
+  c.stiffness = six(stiffness, "stiffness");
+  c.damping = six(damping, "damping");
+  c.max_speed_m_per_s = max_speed_m_per_s;
+  c.max_force_N = max_force_N;
+  locked([&] { arm_->set_compliance(c); });
+}
+
+rccl::StartWhen ArmObject::start_when(const std::vector<WhenObject>& when) const {
+  rccl::StartWhen w;
+  for (const WhenObject& o : when) {
+    w.after.insert(w.after.end(), o.when.after.begin(), o.when.after.end());
+    w.touch |= o.when.touch;
+    if (o.when.together) {
+      if (w.together) raise_value_error("a motion takes part in one joint start only");
+      w.together = o.when.together;
+      w.slot = o.when.slot;
+    }
+  }
+  return w;
+}
+
+MotionObject ArmObject::move(const rccl::PositionPtr& position,
+                             const std::vector<WhenObject>& when) {
+  if (!position) raise_value_error("move: no position given");
+  const rccl::StartWhen w = start_when(when);
+  return {locked([&] { return arm_->move(position, w); })};
+}
+
+MotionObject ArmObject::dwell(double seconds, const std::vector<WhenObject>& when) {
+  const rccl::StartWhen w = start_when(when);
+  return {locked([&] { return arm_->dwell(seconds, w); })};
+}
+
+void ArmObject::halt() {
+  locked([&] { arm_->halt(); });
+}
+void ArmObject::nextmove() {
+  locked([&] { arm_->generator().request_next(); });
+}
+void ArmObject::set_hand(bool closed) {
+  locked([&] { arm_->set_hand(closed); });
+}
+rccl::PositionPtr ArmObject::park() const {
+  return arm_->park();
+}
+
+EventObject ArmObject::ended(const rccl::PositionPtr& p) const {
+  if (!p) raise_value_error("ended: no position given");
+  return {rccl::Arm::ended(p), p};
+}
+
+std::string ArmObject::waitfor(const EventObject& event, std::optional<double> timeout_s) {
+  check_open();
+  rccl::WaitResult r = rccl::WaitResult::timeout;
+  sliced_wait(*owner_, timeout_s, arm_->session().period(), [&](nanoseconds d) {
+    r = arm_->waitfor(event.event, d);
+    return r != rccl::WaitResult::timeout;
+  });
+  return std::string(rccl::to_string(r));
+}
+
+std::optional<std::string> ArmObject::wait_for(double seconds) {
+  const nanoseconds total = seconds_to_ns(seconds, "wait_for");
+  check_open();
+  rtc::Termination t;
+  sliced_wait(*owner_, static_cast<double>(total.count()) * 1e-9, arm_->session().period(),
+              [&](nanoseconds d) {
+                t = arm_->wait_for(d);
+                return t.ended();
+              });
+  if (!t.ended()) return std::nullopt;
+  return termination_text(t);
+}
+
+bool ArmObject::happened(const EventObject& event) {
+  return locked([&] { return arm_->happened(event.event); });
+}
+
+std::vector<rccl::MotionEvent> ArmObject::failures() {
+  return locked([&] { return arm_->failures(); });
+}
+std::vector<rccl::MotionEvent> ArmObject::take_events() {
+  return locked([&] { return arm_->take_events(); });
+}
+rccl::SegmentReport ArmObject::report(const MotionObject& m) {
+  return locked([&] { return arm_->report(m.motion); });
+}
+std::uint64_t ArmObject::last_queued() {
+  return locked([&] { return arm_->last_queued(); });
+}
+KinematicsObject ArmObject::kinematics() const {
+  return KinematicsObject(arm_->kinematics().model());
+}
+bool ArmObject::controlling() const {
+  return !owner_->closed && arm_->session().controlling();
+}
+double ArmObject::time_s() const {
+  return arm_->session().how().time_s;
+}
+OutArray ArmObject::joints() const {
+  return to_array(arm_->session().how().q().span());
+}
+std::string ArmObject::repr() const {
+  return fmt::format("<rccx robot {} ({}), {}>", name_, arm_->kinematics().model().name,
+                     owner_->closed ? "closed" : (controlling() ? "in control" : "not in control"));
+}
+
+// --- RobotObject -----------------------------------------------------------------------------
+
+struct RobotObject::Parts {
+  rtc::SimulatedRobot robot;
+  rccl::Manipulator arm;
+  Parts(kin::RobotModel model, const rtc::SimulatedRobotOptions& options)
+      : robot(std::move(model), options), arm(*robot.session) {}
+};
+
+namespace {
+kin::RobotModel model_of(const std::string& name) {
+  const auto names = kin::builtin_robot_names();
+  if (std::find(names.begin(), names.end(), name) == names.end()) {
+    try {
+      (void)kin::builtin_robot(name);  // its message lists the known names
+    } catch (const kin::RobotFileError& e) {
+      raise_key_error(e.what());
+    }
+  }
+  return kin::builtin_robot(name);
+}
+}  // namespace
+
+RobotObject::RobotObject(const std::string& robot, const std::string& clock,
+                         std::optional<double> period_s, const std::optional<std::string>& log)
+    : RobotObject(
+          [&] {
+            rtc::SimulatedRobotOptions o;
+            o.clock = clock_of(clock);
+            if (period_s) o.period = seconds_to_ns(*period_s, "period");
+            if (log) o.log = *log;
+            kin::RobotModel model = model_of(robot);
+            auto owner = std::make_shared<Owner>();
+            std::shared_ptr<Parts> parts;
+            {
+              const ReleaseGil release;  // starts the session's tasks
+              parts = std::make_shared<Parts>(std::move(model), o);
+              // Ctrl-C during control: halt smoothly (request_halt is lock-free); the next
+              // wait raises KeyboardInterrupt and ends control.
+              rccl::Manipulator* a = &parts->arm;
+              parts->robot.session->set_hangup_handler([a](rtc::Session&) { a->halt(); });
+              parts->arm.start();
+            }
+            Parts* p = parts.get();
+            owner->interrupt = [p] {
+              p->arm.halt();
+              (void)p->arm.waitfor(rccl::Arm::completed(), std::chrono::seconds(1));
+              (void)p->arm.stop_control();
+            };
+            owner->keep = std::move(parts);
+            owner->stops_seen = io::stop_count();
+            return owner;
+          }(),
+          0) {}
+
+RobotObject::RobotObject(std::shared_ptr<Owner> owner, int)
+    : ArmObject(owner, static_cast<Parts*>(owner->keep.get())->arm,
+                static_cast<Parts*>(owner->keep.get())->robot.model.name),
+      parts_(static_cast<Parts*>(owner->keep.get())) {}
+
+void RobotObject::start() {
+  locked([&] { parts_->arm.start(); });
+}
+
+void RobotObject::close() {
+  std::string problem;
+  {
+    const ReleaseGil release;
+    const std::lock_guard lock(owner_->planning);
+    if (owner_->closed) return;
+    owner_->closed = true;
+    (void)parts_->arm.stop_control();
+    problem = parts_->robot.finish();
+  }
+  if (!problem.empty()) throw rtc::LogError(problem);
+}
+
+double RobotObject::period_s() const {
+  return parts_->robot.period_s();
+}
+
+// --- CellObject ------------------------------------------------------------------------------
+
+CellObject::CellObject(const std::string& path, const std::string& clock, bool collision_checks)
+    : owner_(std::make_shared<Owner>()) {
+  cell::CellOptions o;
+  o.clock = clock_of(clock);
+  o.collision_checks = collision_checks;
+  {
+    const ReleaseGil release;
+    cell_ = std::shared_ptr<cell::Cell>(cell::Cell::load(path, o));
+  }
+  cell::Cell* c = cell_.get();
+  owner_->interrupt = [c] {
+    for (const std::string& n : c->robot_names()) c->robot(n).halt();
+    std::vector<rccl::EventGate> all;
+    for (const std::string& n : c->robot_names()) {
+      all.push_back(c->event(n, rccl::Arm::completed()));
+    }
+    (void)c->waitfor(all, std::chrono::seconds(1));
+    for (const std::string& n : c->robot_names()) (void)c->robot(n).stop_control();
+  };
+  owner_->keep = cell_;
+  owner_->stops_seen = io::stop_count();
+  for (const std::string& n : c->robot_names()) {
+    rccl::Manipulator* a = &c->robot(n);
+    c->session(n).set_hangup_handler([a](rtc::Session&) { a->halt(); });
+  }
+}
+
+void CellObject::start() {
+  locked([&] { cell_->start(); });
+}
+
+ArmObject CellObject::robot(const std::string& name) {
+  rccl::Manipulator& m = locked([&]() -> rccl::Manipulator& { return cell_->robot(name); });
+  return ArmObject(owner_, m, name);
+}
+
+std::vector<std::string> CellObject::robot_names() const {
+  return cell_->robot_names();
+}
+
+GateObject CellObject::event(const std::string& robot, const EventObject& event) {
+  return {locked([&] { return cell_->event(robot, event.event); }), owner_};
+}
+
+WhenObject CellObject::after(const std::string& robot, const EventObject& event) {
+  return {locked([&] { return cell_->after(robot, event.event); }), owner_};
+}
+
+WhenObject CellObject::touching(const std::vector<std::string>& objects) {
+  return {locked([&] { return cell_->touching(objects); }), owner_};
+}
+
+std::string CellObject::waitfor(const std::vector<GateObject>& gates,
+                                std::optional<double> timeout_s) {
+  std::vector<rccl::EventGate> g;
+  for (const GateObject& o : gates) {
+    if (o.owner != owner_) raise_value_error("waitfor: an event of another cell");
+    g.push_back(o.gate);
+  }
+  rccl::WaitResult r = rccl::WaitResult::timeout;
+  if (owner_->closed) throw rtc::SessionError("the cell is closed");
+  ArmObject::sliced_wait(*owner_, timeout_s, cell_->group().period(), [&](nanoseconds d) {
+    r = cell_->waitfor(g, d);
+    return r != rccl::WaitResult::timeout;
+  });
+  return std::string(rccl::to_string(r));
+}
+
+void CellObject::wait_for(double seconds) {
+  const nanoseconds total = seconds_to_ns(seconds, "wait_for");
+  if (owner_->closed) throw rtc::SessionError("the cell is closed");
+  ArmObject::sliced_wait(*owner_, static_cast<double>(total.count()) * 1e-9,
+                         cell_->group().period(), [&](nanoseconds d) {
+                           cell_->wait_for(d);
+                           return false;
+                         });
+}
+
+rccl::TransformPtr CellObject::tool_frame(const std::string& robot) {
+  return locked([&] { return cell_->tool_frame(robot); });
+}
+rccl::TransformPtr CellObject::tool_transform(const std::string& robot) {
+  return locked([&] { return cell_->tool_transform(robot); });
+}
+rccl::TransformPtr CellObject::base_inv_transform(const std::string& robot) {
+  return locked([&] { return cell_->base_inv_transform(robot); });
+}
+OutArray CellObject::base(const std::string& robot) {
+  return transform_out(locked([&] { return cell_->base(robot); }));
+}
+rccl::PositionPtr CellObject::world_goal(const std::string& robot, const std::string& name,
+                                         const InArray& world_pose) {
+  const math::Transform T = transform_in(world_pose, "world_goal " + name);
+  return locked([&] { return cell_->world_goal(robot, name, T); });
+}
+
+TogetherObject CellObject::together(const std::vector<std::string>& robots, bool end_together) {
+  return {std::make_shared<cell::Together>(
+              locked([&] { return cell_->together(robots, end_together); })),
+          owner_};
+}
+
+WhenObject TogetherObject::when(const std::string& robot) const {
+  return {together->when(robot), owner};
+}
+
+void CellObject::close() {
+  bool whole = true;
+  {
+    const ReleaseGil release;
+    const std::lock_guard lock(owner_->planning);
+    if (owner_->closed) return;
+    owner_->closed = true;
+    whole = cell_->finish_logs("python");
+  }
+  if (!whole) throw rtc::LogError("a robot's sample log is lost (said on stderr)");
+}
+
+}  // namespace rccx::python

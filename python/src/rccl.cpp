@@ -1,0 +1,168 @@
+// rccx's position equations for Python: transforms checked and copied between NumPy arrays and
+// math::Transform, the C++ errors left to carry rccx's messages (EquationError, MotionError are
+// registered as Python exceptions in arm_module.cpp).
+#include "rccl.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace rccx::python {
+
+namespace {
+
+bool all_finite(const double* v, std::size_t n) {
+  return std::all_of(v, v + n, [](double x) { return std::isfinite(x); });
+}
+
+std::int64_t steady_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(
+             std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+
+}  // namespace
+
+math::Transform transform_in(const InArray& a, const std::string& what) {
+  if (ndim(a) != 2 || extent(a, 0) != 4 || extent(a, 1) != 4) {
+    raise_value_error(fmt::format("{}: T must be a (4, 4) homogeneous transform (m), got shape {}",
+                                  what, shape_text(a)));
+  }
+  const double* m = a.data();
+  if (!all_finite(m, 16)) raise_value_error(fmt::format("{}: T has a non-finite element", what));
+  if (m[12] != 0.0 || m[13] != 0.0 || m[14] != 0.0 || m[15] != 1.0) {
+    raise_value_error(fmt::format("{}: T's last row must be 0 0 0 1, got {} {} {} {}", what, m[12],
+                                  m[13], m[14], m[15]));
+  }
+  const math::Transform T = math::Transform::from_rows(
+      {m[0], m[1], m[2], m[3], m[4], m[5], m[6], m[7], m[8], m[9], m[10], m[11]});
+  if (!rccl::is_rigid(T)) {
+    raise_value_error(fmt::format(
+        "{}: T's rotation part is not a rotation matrix; give an orthonormal, right-handed frame "
+        "(within 1e-6)",
+        what));
+  }
+  return T;
+}
+
+OutArray transform_out(const math::Transform& T) {
+  OutArray out = new_array({4, 4});
+  double* o = out.mutable_data();
+  for (int r = 0; r < 4; ++r) {
+    for (int c = 0; c < 4; ++c) *o++ = T(r, c);
+  }
+  return out;
+}
+
+rccl::TransformPtr make_constant(const std::string& name, const InArray& T) {
+  return rccl::constant(name, transform_in(T, "const " + name));
+}
+
+rccl::TransformPtr make_hold(const std::string& name, const std::optional<InArray>& T) {
+  return rccl::hold(name, T ? transform_in(*T, "hold " + name) : math::Transform::identity());
+}
+
+void set_hold(rccl::Transform& t, const InArray& T) {
+  if (t.kind() != rccl::TransformKind::hold) {
+    throw py::type_error(fmt::format("{} is a {} transform: only a hold transform can be set",
+                                     t.name(), rccl::to_string(t.kind())));
+  }
+  t.set(transform_in(T, t.name() + ".set"));
+}
+
+OutArray transform_value(const rccl::Transform& t) {
+  switch (t.kind()) {
+    case rccl::TransformKind::constant:
+    case rccl::TransformKind::hold:
+      return transform_out(t.value());
+    case rccl::TransformKind::functional:
+      return transform_out(t.value_now({}));
+    case rccl::TransformKind::t6:
+      break;
+  }
+  raise_value_error("T6 has no value of its own: it is the unknown of the equations");
+}
+
+std::string transform_repr(const rccl::Transform& t) {
+  return fmt::format("rccx.Transform('{}', {})", t.name(), rccl::to_string(t.kind()));
+}
+
+StreamTransform::StreamTransform(std::string name, std::shared_ptr<State> state)
+    : rccl::Transform(std::move(name), rccl::TransformKind::functional, math::Transform::identity(),
+                      // The loop's read: the newest sample, lock-free; never Python.
+                      [s = state](const rccl::SampleContext&) {
+                        Sample sample;
+                        return s->latest.load(sample) ? sample.pose : s->initial;
+                      }),
+      state_(std::move(state)) {}
+
+void StreamTransform::put(const InArray& T) {
+  const math::Transform pose = transform_in(T, name() + ".put");
+  const ReleaseGil release;  // another writer may hold the lock a moment
+  const std::lock_guard lock(state_->writers);
+  state_->latest.store({pose, steady_ns()});
+  ++state_->count;
+}
+
+OutArray StreamTransform::newest() const {
+  Sample s;
+  return transform_out(state_->latest.load(s) ? s.pose : state_->initial);
+}
+
+std::optional<double> StreamTransform::age() const {
+  Sample s;
+  if (!state_->latest.load(s)) return std::nullopt;
+  return static_cast<double>(steady_ns() - s.stamp_ns) * 1e-9;
+}
+
+std::uint64_t StreamTransform::count() const {
+  const std::lock_guard lock(state_->writers);
+  return state_->count;
+}
+
+std::shared_ptr<StreamTransform> make_stream(const std::string& name,
+                                             const std::optional<InArray>& T) {
+  auto state = std::make_shared<StreamTransform::State>();
+  state->initial = T ? transform_in(*T, "stream " + name) : math::Transform::identity();
+  return std::make_shared<StreamTransform>(name, std::move(state));
+}
+
+rccl::PositionPtr make_position(const std::string& name, const std::vector<rccl::TransformPtr>& lhs,
+                                const std::vector<rccl::TransformPtr>& rhs,
+                                const rccl::TransformPtr& tool) {
+  return tool ? rccl::Position::make(name, lhs, rhs, tool) : rccl::Position::make(name, lhs, rhs);
+}
+
+rccl::PositionPtr make_joints(const std::string& name, const InArray& q) {
+  if (ndim(q) != 1 || extent(q, 0) == 0 || extent(q, 0) > kin::kMaxJoints) {
+    raise_value_error(fmt::format(
+        "joints {}: q must have shape (dof,) (rad or m), at most {} values, got shape {}", name,
+        kin::kMaxJoints, shape_text(q)));
+  }
+  if (!all_finite(q.data(), extent(q, 0))) {
+    raise_value_error(fmt::format("joints {}: q has a non-finite value", name));
+  }
+  return rccl::Position::joints(name,
+                                kin::JointVector(std::span<const double>(q.data(), extent(q, 0))));
+}
+
+OutArray position_t6(const rccl::Position& p) {
+  if (p.in_joints()) raise_value_error(p.name() + " is given in joints: it has no equation");
+  if (p.moves()) {
+    raise_value_error(p.name() + " has a functional transform: its T6 depends on the sample");
+  }
+  return transform_out(p.t6_now());
+}
+
+OutArray position_tool(const rccl::Position& p) {
+  return transform_out(p.tool_now());
+}
+
+OutArray position_joints(const rccl::Position& p) {
+  if (!p.in_joints()) raise_value_error(p.name() + " is an equation, not joint values");
+  return to_array(p.joint_values().span());
+}
+
+}  // namespace rccx::python

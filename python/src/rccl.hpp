@@ -1,0 +1,77 @@
+// rccx's position equations for Python (docs/PYTHON.md, "Position equations"): NumPy (4, 4)
+// arrays to and from math::Transform, the transforms' factories and a stream-fed functional
+// transform. Plain C++ over arrays.hpp; arm_module.cpp names them for Python.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "arrays.hpp"
+#include "rccx/cell/seqlock.hpp"
+#include "rccx/rccl/position.hpp"
+#include "rccx/rccl/transforms.hpp"
+
+namespace rccx::python {
+
+/// A (4, 4) homogeneous transform (m) from Python: finite, last row 0 0 0 1, an orthonormal
+/// right-handed rotation within 1e-6; ValueError naming `what` otherwise.
+math::Transform transform_in(const InArray& a, const std::string& what);
+/// T as a new (4, 4) float64 array.
+OutArray transform_out(const math::Transform& T);
+
+rccl::TransformPtr make_constant(const std::string& name, const InArray& T);
+rccl::TransformPtr make_hold(const std::string& name, const std::optional<InArray>& T);
+/// A hold transform's set(); TypeError for the other kinds.
+void set_hold(rccl::Transform& t, const InArray& T);
+/// A constant's or hold's value; a functional's value now; ValueError for T6.
+OutArray transform_value(const rccl::Transform& t);
+std::string transform_repr(const rccl::Transform& t);
+
+/// A functional transform fed by the program: put() (any thread, never waiting for the loop)
+/// publishes a pose, the sample loop reads the newest one through a sequence lock (no lock, no
+/// allocation, no Python). Before the first put() its value is the initial pose.
+class StreamTransform : public rccl::Transform {
+ public:
+  struct Sample {
+    math::Transform pose;
+    std::int64_t stamp_ns = 0;  ///< steady clock when put
+  };
+  struct State {
+    cell::SeqLock<Sample> latest;
+    math::Transform initial;
+    std::mutex writers;  ///< the seqlock takes one writer at a time; the loop never takes it
+    std::uint64_t count = 0;
+  };
+  StreamTransform(std::string name, std::shared_ptr<State> state);
+
+  void put(const InArray& T);
+  /// The newest pose put (the initial one before any).
+  [[nodiscard]] OutArray newest() const;
+  /// Seconds since the newest put(); None before the first.
+  [[nodiscard]] std::optional<double> age() const;
+  [[nodiscard]] std::uint64_t count() const;
+
+ private:
+  std::shared_ptr<State> state_;
+};
+
+std::shared_ptr<StreamTransform> make_stream(const std::string& name,
+                                             const std::optional<InArray>& T);
+
+/// Position::make with the tool given (null: the left side's last transform).
+rccl::PositionPtr make_position(const std::string& name, const std::vector<rccl::TransformPtr>& lhs,
+                                const std::vector<rccl::TransformPtr>& rhs,
+                                const rccl::TransformPtr& tool);
+/// A position in joints (rad / m): finite values, a 1-D array.
+rccl::PositionPtr make_joints(const std::string& name, const InArray& q);
+/// T6 of a position without functional transforms (holds as last set), m.
+OutArray position_t6(const rccl::Position& p);
+OutArray position_tool(const rccl::Position& p);
+OutArray position_joints(const rccl::Position& p);
+
+}  // namespace rccx::python
