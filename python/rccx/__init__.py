@@ -26,3 +26,8 @@ __all__ += ["Arm", "Cell", "CellFileError", "Equation", "EquationError", "Event"
             "LogError", "Motion", "MotionError", "Position", "Product", "Robot", "SessionError",
             "Stream", "Together", "Transform", "When", "const", "hold", "joints", "position",
             "stream", "t6"]
+# Force: the wrist sensor's reading compensated and carried to the tool (python/examples/
+# touch_and_wipe.py).
+from ._rccx import external_wrench, wrench_at_tool
+
+__all__ += ["external_wrench", "wrench_at_tool"]

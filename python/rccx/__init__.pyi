@@ -41,3 +41,7 @@ __all__ += ["Arm", "Cell", "CellFileError", "Equation", "EquationError", "Event"
             "LogError", "Motion", "MotionError", "Position", "Product", "Robot", "SessionError",
             "Stream", "Together", "Transform", "When", "const", "hold", "joints", "position",
             "stream", "t6"]
+# Force (rccx/motion.pyi).
+from .motion import external_wrench as external_wrench, wrench_at_tool as wrench_at_tool
+
+__all__ += ["external_wrench", "wrench_at_tool"]

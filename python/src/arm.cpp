@@ -12,6 +12,8 @@
 
 #include "rccl.hpp"
 #include "rccx/cell/cell_model.hpp"
+#include "rccx/force/tool_load.hpp"
+#include "rccx/hw/mjcf.hpp"
 #include "rccx/io/signals.hpp"
 #include "rccx/kinematics/robot_model.hpp"
 
@@ -80,6 +82,38 @@ nanoseconds slice_of(nanoseconds period) {
 }
 
 constexpr nanoseconds kForever = std::chrono::hours(24 * 365);
+
+math::Vec3 vec3_of(const std::optional<InArray>& a, const char* what) {
+  if (!a) return {};
+  if (ndim(*a) != 1 || extent(*a, 0) != 3 || !std::isfinite(a->data()[0]) ||
+      !std::isfinite(a->data()[1]) || !std::isfinite(a->data()[2])) {
+    raise_value_error(
+        fmt::format("{} must be 3 finite numbers (m), got shape {}", what, shape_text(*a)));
+  }
+  return {a->data()[0], a->data()[1], a->data()[2]};
+}
+
+math::Wrench wrench_of(const std::optional<InArray>& a, const char* what) {
+  std::array<double, 6> w = six(a, what);
+  for (double v : w) {
+    if (!std::isfinite(v)) raise_value_error(fmt::format("{} must be finite", what));
+  }
+  return math::Wrench::from_array(w);
+}
+
+OutArray wrench_out(const math::Wrench& w) {
+  const std::array<double, 6> a = w.to_array();
+  return to_array(a);
+}
+
+hw::Plant plant_of(const std::string& plant) {
+  for (hw::Plant p :
+       {hw::Plant::automatic, hw::Plant::ideal, hw::Plant::servo, hw::Plant::mujoco}) {
+    if (kin::to_string(p) == plant) return p;
+  }
+  raise_value_error(fmt::format(
+      "plant must be \"automatic\", \"ideal\", \"servo\" or \"mujoco\", got \"{}\"", plant));
+}
 
 }  // namespace
 
@@ -316,6 +350,37 @@ std::string ArmObject::repr() const {
                      owner_->closed ? "closed" : (controlling() ? "in control" : "not in control"));
 }
 
+void ArmObject::set_tool_load(double mass_kg, const std::optional<InArray>& com_m,
+                              const std::optional<InArray>& bias) {
+  if (!std::isfinite(mass_kg) || mass_kg < 0.0) {
+    raise_value_error(fmt::format("mass_kg must be a finite number >= 0, got {}", mass_kg));
+  }
+  force::ToolLoad load;
+  load.mass_kg = mass_kg;
+  load.com_m = vec3_of(com_m, "com_m");
+  load.bias = wrench_of(bias, "bias");
+  locked([&] { arm_->set_tool_load(load); });
+}
+
+std::optional<rccl::Contact> ArmObject::contact(const MotionObject& m) {
+  return locked([&] { return arm_->contact(m.motion); });
+}
+
+void ArmObject::update_from_contact(const MotionObject& m, const rccl::TransformPtr& x,
+                                    const rccl::PositionPtr& position) {
+  locked([&] { arm_->update_from_contact(m.motion, x, position); });
+}
+
+std::optional<OutArray> ArmObject::wrench() const {
+  const rtc::How h = arm_->session().how();
+  if (!h.force.present) return std::nullopt;
+  return wrench_out(h.force.wrench);
+}
+
+bool ArmObject::hand_closed() const {
+  return arm_->session().how().hand_closed;
+}
+
 // --- RobotObject -----------------------------------------------------------------------------
 
 struct RobotObject::Parts {
@@ -340,7 +405,8 @@ kin::RobotModel model_of(const std::string& name) {
 }  // namespace
 
 RobotObject::RobotObject(const std::string& robot, const std::string& clock,
-                         std::optional<double> period_s, const std::optional<std::string>& log)
+                         std::optional<double> period_s, const std::optional<std::string>& log,
+                         const std::string& plant, const std::string& scene_json)
     : RobotObject(
           [&] {
             rtc::SimulatedRobotOptions o;
@@ -348,6 +414,17 @@ RobotObject::RobotObject(const std::string& robot, const std::string& clock,
             if (period_s) o.period = seconds_to_ns(*period_s, "period");
             if (log) o.log = *log;
             kin::RobotModel model = model_of(robot);
+            o.plant = plant_of(plant);
+            if (!scene_json.empty()) {
+              // The scene read as a robot file's would be (its keys, checks and messages).
+              kin::RobotModel with_scene = model;
+              with_scene.hardware_json = R"({"mujoco": )" + scene_json + "}";
+              try {
+                o.scene = std::make_shared<hw::Scene>(hw::scene_from_file(with_scene));
+              } catch (const std::invalid_argument& e) {
+                raise_value_error(fmt::format("scene: {}", e.what()));
+              }
+            }
             auto owner = std::make_shared<Owner>();
             std::shared_ptr<Parts> parts;
             {
@@ -515,6 +592,46 @@ void CellObject::close() {
     whole = cell_->finish_logs("python");
   }
   if (!whole) throw rtc::LogError("a robot's sample log is lost (said on stderr)");
+}
+
+OutArray CellObject::frame(const std::string& name) {
+  const cell::CellFrame* f = cell_->model().find_frame(name);
+  if (f == nullptr) {
+    std::string known;
+    for (const cell::CellFrame& g : cell_->model().frames)
+      known += (known.empty() ? "" : ", ") + g.name;
+    raise_key_error(fmt::format("cell {} has no frame \"{}\" (it has: {})", cell_->model().name,
+                                name, known.empty() ? "none" : known));
+  }
+  return transform_out(f->pose);
+}
+
+double CellObject::period_s() const {
+  return std::chrono::duration<double>(cell_->model().base_period).count();
+}
+
+std::uint64_t CellObject::collision_stops() const {
+  return cell_->collision_stops();
+}
+
+// --- force --------------------------------------------------------------------------------
+
+OutArray external_wrench(const InArray& reading, const InArray& world_from_t6, double mass_kg,
+                         const std::optional<InArray>& com_m, const std::optional<InArray>& bias) {
+  if (!std::isfinite(mass_kg) || mass_kg < 0.0) {
+    raise_value_error(fmt::format("mass_kg must be a finite number >= 0, got {}", mass_kg));
+  }
+  force::ToolLoad load;
+  load.mass_kg = mass_kg;
+  load.com_m = vec3_of(com_m, "com_m");
+  load.bias = wrench_of(bias, "bias");
+  const math::Transform T = transform_in(world_from_t6, "world_from_t6");
+  return wrench_out(force::external_wrench(load, T.R, wrench_of(reading, "reading")));
+}
+
+OutArray wrench_at_tool(const InArray& t6_from_tool, const InArray& at_t6) {
+  const math::Transform T = transform_in(t6_from_tool, "t6_from_tool");
+  return wrench_out(force::at_tool(T, wrench_of(at_t6, "wrench")));
 }
 
 }  // namespace rccx::python

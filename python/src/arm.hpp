@@ -106,6 +106,22 @@ class ArmObject {
   [[nodiscard]] const std::string& name() const noexcept { return name_; }
   [[nodiscard]] std::string repr() const;
 
+  // Force (issue 15) from Python (python/examples/touch_and_wipe.py): a robot with a wrist
+  // sensor (rccx.Robot(plant="mujoco")).
+  /// The tool's weight and the sensor's bias, taken out of the readings guards and compliance
+  /// use (force::ToolLoad): kg, m in T6, (6,) N and N m.
+  void set_tool_load(double mass_kg, const std::optional<InArray>& com_m,
+                     const std::optional<InArray>& bias);
+  /// Where motion `m`'s guard tripped (rccl::Contact), None without a contact.
+  [[nodiscard]] std::optional<rccl::Contact> contact(const MotionObject& m);
+  void update_from_contact(const MotionObject& m, const rccl::TransformPtr& x,
+                           const rccl::PositionPtr& position);
+  /// The last sample's sensor reading (6,), N and N m about T6 in T6's axes; None without a
+  /// sensor.
+  [[nodiscard]] std::optional<OutArray> wrench() const;
+  /// The hand as the last sample read reports it (closed: True).
+  [[nodiscard]] bool hand_closed() const;
+
   /// Runs `step(slice)` (the GIL released, the planning lock taken) until it returns true or
   /// `timeout` has passed (false); between slices checks for signals (Ctrl-C: interrupts the
   /// owner, raises KeyboardInterrupt). `period`: the slowest sample period concerned.
@@ -134,8 +150,11 @@ class ArmObject {
 /// rccx.Robot: a simulated robot (rtc::SimulatedRobot) with its Manipulator, control started.
 class RobotObject : public ArmObject {
  public:
+  /// plant: "automatic", "ideal", "servo" or "mujoco"; scene_json: the MuJoCo plant's scene as
+  /// a robot file's "hardware": {"mujoco": ...} block (JSON text; empty: the file's).
   RobotObject(const std::string& robot, const std::string& clock, std::optional<double> period_s,
-              const std::optional<std::string>& log);
+              const std::optional<std::string>& log, const std::string& plant = "automatic",
+              const std::string& scene_json = "");
   /// Stops control and closes the session, its log put in place; raises LogError for a lost
   /// log. Idempotent.
   void close();
@@ -182,6 +201,13 @@ class CellObject {
   /// A joint start of `robots`; its when(robot) goes to each robot's move.
   TogetherObject together(const std::vector<std::string>& robots, bool end_together);
   void close();
+  // For python/examples/circuit_board.py: the cell file's frames, its clock, its collision stops.
+  /// A named frame of the cell file, world <- frame (4, 4), m; KeyError when there is none.
+  OutArray frame(const std::string& name);
+  /// The cell's clock tick, s (each robot samples every period_multiple ticks).
+  [[nodiscard]] double period_s() const;
+  /// Times the collision check stopped the arms.
+  [[nodiscard]] std::uint64_t collision_stops() const;
 
  private:
   template <class F>
@@ -194,5 +220,12 @@ class CellObject {
   std::shared_ptr<Owner> owner_;
   std::shared_ptr<cell::Cell> cell_;
 };
+
+/// force::external_wrench: the contacts' wrench (6,) about T6 from a sensor reading (6,), the
+/// sensor's orientation in the world (T6 (4, 4) in a world whose z is up) and the tool's load.
+OutArray external_wrench(const InArray& reading, const InArray& world_from_t6, double mass_kg,
+                         const std::optional<InArray>& com_m, const std::optional<InArray>& bias);
+/// force::at_tool: a wrench (6,) about T6 expressed about the tool frame (t6_from_tool (4, 4)).
+OutArray wrench_at_tool(const InArray& t6_from_tool, const InArray& at_t6);
 
 }  // namespace rccx::python

@@ -4,6 +4,9 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <array>
+#include <memory>
+
 #include "arm.hpp"
 #include "rccl.hpp"
 #include "rccx/cell/cell_model.hpp"
@@ -271,18 +274,74 @@ void bind_rccl(py::module_& m) {
                              "The last sample's time, s since the session opened.")
       .def_property_readonly("q", &ArmObject::joints,
                              "The measured joints of the last sample (dof,), rad or m.")
-      .def("__repr__", &ArmObject::repr);
+      .def("__repr__", &ArmObject::repr)
+      // Force (a robot with a wrist sensor: rccx.Robot(plant="mujoco")).
+      .def("set_tool_load", &ArmObject::set_tool_load, py::arg("mass_kg"),
+           py::arg("com_m") = py::none(), py::arg("bias") = py::none(),
+           "set_tool_load: the tool's mass (kg), centre of mass (3,) m in T6 and the sensor's "
+           "bias (6,) N, N m, taken out of the readings guards and compliance use.")
+      .def(
+          "contact",
+          [](ArmObject& a, const MotionObject& mo) -> py::object {
+            const auto c = a.contact(mo);
+            if (!c) return py::none();
+            py::dict d;
+            d["motion"] = c->motion;
+            d["t"] = c->t_s;
+            d["t6"] = transform_out(c->t6);
+            d["tool_frame"] = transform_out(c->tool_frame);
+            const std::array<double, 6> w = c->wrench.to_array();
+            d["wrench"] = to_array(w);
+            return d;
+          },
+          py::arg("motion"),
+          "Where `motion`'s guard tripped: dict motion, t (s, when the force began to rise), t6 "
+          "and tool_frame (4, 4) m (measured; tool_frame = T6 TOOL), wrench (6,) N, N m (tool "
+          "frame). None when it made no contact or has not ended.")
+      .def("update_from_contact", &ArmObject::update_from_contact, py::arg("motion"),
+           py::arg("transform"), py::arg("position"),
+           "RCCL's update: sets `transform` (a hold or constant of `position`) so that "
+           "`position` solves with T6 where `motion`'s contact was. rccx.MotionError without a "
+           "contact.")
+      .def_property_readonly("wrench", &ArmObject::wrench,
+                             "The last sample's wrist sensor reading (6,): N, N m about T6 in "
+                             "T6's axes (bias, tool weight and contacts); None without a sensor.")
+      .def_property_readonly("hand_closed", &ArmObject::hand_closed,
+                             "The hand as the last sample read reports it (True: closed).");
+
+  m.def("external_wrench", &external_wrench, py::arg("reading"), py::arg("world_from_t6"),
+        py::arg("mass_kg") = 0.0, py::arg("com_m") = py::none(), py::arg("bias") = py::none(),
+        "C++ force::external_wrench: what contacts put on the tool (6,) N, N m about T6, from a "
+        "sensor reading (6,), T6 (4, 4) in a world whose z is up (only its rotation counts), and "
+        "the tool's mass kg, centre of mass (3,) m in T6, the sensor's bias (6,).");
+  m.def("wrench_at_tool", &wrench_at_tool, py::arg("t6_from_tool"), py::arg("wrench"),
+        "C++ force::at_tool: a wrench (6,) about T6 in T6's axes, expressed about the tool frame "
+        "(t6_from_tool (4, 4), RCCL's TOOL) in its axes.");
 
   py::class_<RobotObject, ArmObject>(
       m, "Robot",
       "A simulated robot (C++ rtc::SimulatedRobot + rccl::Manipulator), control started. "
       "robot: a shipped robot's name; clock: \"simulated\" (deterministic, time runs while "
       "the program waits) or \"real_time\"; period: s (None: the robot's usual one); log: a "
-      "CSV of every sample (None: RCCX_LOG's, if set). close() (or with-block) ends control.")
-      .def(py::init<const std::string&, const std::string&, std::optional<double>,
-                    const std::optional<std::string>&>(),
+      "CSV of every sample (None: RCCX_LOG's, if set). close() (or with-block) ends control. "
+      "plant: \"automatic\" (the robot file's), \"ideal\", \"servo\" or \"mujoco\" (a "
+      "wrist sensor); scene: the MuJoCo plant's table, boxes and tool, a dict as a robot file's "
+      "\"hardware\": {\"mujoco\": ...} (robots/README.md; ValueError naming a bad key).")
+      .def(py::init([](const std::string& robot, const std::string& clock,
+                       std::optional<double> period, const std::optional<std::string>& log,
+                       const std::string& plant, const py::object& scene) {
+             // A dict (the robot file's "mujoco" block) goes to C++ as its JSON text.
+             std::string json;
+             if (py::isinstance<py::str>(scene)) {
+               json = scene.cast<std::string>();
+             } else if (!scene.is_none()) {
+               json = py::module_::import("json").attr("dumps")(scene).cast<std::string>();
+             }
+             return std::make_unique<RobotObject>(robot, clock, period, log, plant, json);
+           }),
            py::arg("robot") = "microbo", py::arg("clock") = "simulated",
-           py::arg("period") = py::none(), py::arg("log") = py::none())
+           py::arg("period") = py::none(), py::arg("log") = py::none(),
+           py::arg("plant") = "automatic", py::arg("scene") = py::none())
       .def("close", &RobotObject::close,
            "Stops control and closes the session, its log put in place; raises rccx.LogError "
            "when the log is lost. Later calls on the robot raise rccx.SessionError.")
@@ -333,6 +392,14 @@ void bind_rccl(py::module_& m) {
       .def("together", &CellObject::together, py::arg("robots"), py::arg("end_together") = false,
            "A joint start: each robot's move(after=together.when(robot)) starts in one sample.")
       .def("close", &CellObject::close, "Stops every robot; their logs put in place.")
+      .def("frame", &CellObject::frame, py::arg("name"),
+           "A named frame of the cell file (\"board_home\" ...), world <- frame (4, 4), m; "
+           "KeyError naming the known ones.")
+      .def_property_readonly("period", &CellObject::period_s,
+                             "The cell's clock tick, s (a robot samples every period_multiple "
+                             "ticks).")
+      .def_property_readonly("collision_stops", &CellObject::collision_stops,
+                             "Times the collision check stopped the arms.")
       .def("__enter__", [](py::object self) { return self; })
       .def("__exit__", [](CellObject& c, const py::args&) { c.close(); });
 }
