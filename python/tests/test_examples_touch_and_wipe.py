@@ -83,6 +83,19 @@ def test_mujoco_robot_arguments():
             arm.update_from_contact(m, rccx.hold("X"), arm.park)
     with rccx.Robot("puma560", plant="mujoco") as arm:
         assert arm.wrench.shape == (6,)
+    with rccx.Robot("puma560", plant="mujoco", scene='{"tool": {"mass_kg": 1.0}}') as arm:
+        arm.wait_for(0.1)  # the sensor reads the tool's weight, whichever way T6 points
+        assert abs(np.linalg.norm(arm.wrench[:3]) - 9.81) < 0.3, arm.wrench
+        contact = rccx.external_wrench(arm.wrench, arm.kinematics.forward(arm.q), 1.0)
+        assert np.abs(contact[:3]).max() < 0.3, contact
+
+
+def test_no_table_no_contact():
+    """The table 90 mm below where the program believes it: the guarded move (down to 30 mm
+    below) ends without contact, and the example says so and exits 1."""
+    p = run_python("touch_and_wipe", "--table-mm", -290)
+    assert p.returncode == 1, p.stdout + p.stderr
+    assert "no contact" in p.stderr
 
 
 def test_help():
