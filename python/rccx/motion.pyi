@@ -152,7 +152,9 @@ class Robot(Arm):
     def __init__(self, robot: str = "microbo", clock: Literal["simulated", "real_time"] = ...,
                  period: Optional[float] = None, log: Optional[str] = None,
                  plant: Literal["automatic", "ideal", "servo", "mujoco"] = "automatic",
-                 scene: Union[None, str, dict[str, Any]] = None) -> None: ...
+                 scene: Union[None, str, dict[str, Any]] = None) -> None:
+        """plant "mujoco" gives a wrist sensor; scene: its table, boxes and tool as a robot
+        file's "hardware": {"mujoco": ...} block (implies plant "mujoco")."""
     def close(self) -> None: ...
     def start(self) -> None: ...
     @property

@@ -416,6 +416,14 @@ RobotObject::RobotObject(const std::string& robot, const std::string& clock,
             kin::RobotModel model = model_of(robot);
             o.plant = plant_of(plant);
             if (!scene_json.empty()) {
+              // A scene is the MuJoCo plant's: it implies that plant, and no other takes one.
+              if (o.plant == hw::Plant::automatic) o.plant = hw::Plant::mujoco;
+              if (o.plant != hw::Plant::mujoco) {
+                raise_value_error(
+                    fmt::format("scene: only the \"mujoco\" plant has a scene, not "
+                                "\"{}\"",
+                                plant));
+              }
               // The scene read as a robot file's would be (its keys, checks and messages).
               kin::RobotModel with_scene = model;
               with_scene.hardware_json = R"({"mujoco": )" + scene_json + "}";

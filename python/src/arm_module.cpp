@@ -335,7 +335,15 @@ void bind_rccl(py::module_& m) {
              if (py::isinstance<py::str>(scene)) {
                json = scene.cast<std::string>();
              } else if (!scene.is_none()) {
-               json = py::module_::import("json").attr("dumps")(scene).cast<std::string>();
+               // NumPy arrays and numbers as lists and floats (tolist); others: TypeError.
+               const py::cpp_function as_list([](const py::object& o) -> py::object {
+                 if (py::hasattr(o, "tolist")) return o.attr("tolist")();
+                 throw py::type_error("scene: " + py::repr(o).cast<std::string>() +
+                                      " is not a number, string, list or dict");
+               });
+               json = py::module_::import("json")
+                          .attr("dumps")(scene, py::arg("default") = as_list)
+                          .cast<std::string>();
              }
              return std::make_unique<RobotObject>(robot, clock, period, log, plant, json);
            }),

@@ -72,6 +72,10 @@ def test_mujoco_robot_arguments():
                    scene={"boxes": [{"name": "t", "half_size_m": [0, 1, 1]}]})
     with pytest.raises(ValueError, match="no_such_key"):
         rccx.Robot("puma560", plant="mujoco", scene={"no_such_key": 1})
+    with pytest.raises(ValueError, match="only the \"mujoco\" plant"):
+        rccx.Robot("puma560", plant="servo", scene={})
+    with pytest.raises(TypeError, match="scene"):
+        rccx.Robot("puma560", scene={"tool": {"mass_kg": object()}})
     with rccx.Robot("puma560") as arm:  # the servo plant: no sensor
         assert arm.wrench is None
         with pytest.raises(ValueError, match="mass_kg"):
@@ -83,6 +87,10 @@ def test_mujoco_robot_arguments():
             arm.update_from_contact(m, rccx.hold("X"), arm.park)
     with rccx.Robot("puma560", plant="mujoco") as arm:
         assert arm.wrench.shape == (6,)
+    # A scene as JSON text, or with NumPy values; it implies the MuJoCo plant.
+    scene = {"tool": {"com_m": np.zeros(3), "mass_kg": np.float64(1)}}
+    with rccx.Robot("puma560", scene=scene) as arm:
+        assert arm.wrench is not None
     with rccx.Robot("puma560", plant="mujoco", scene='{"tool": {"mass_kg": 1.0}}') as arm:
         arm.wait_for(0.1)  # the sensor reads the tool's weight, whichever way T6 points
         assert abs(np.linalg.norm(arm.wrench[:3]) - 9.81) < 0.3, arm.wrench
