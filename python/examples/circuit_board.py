@@ -12,6 +12,9 @@ PUMA's tool is, so each test pad the Microbo probes is the equation
 which the Microbo's generator evaluates every sample: its goals stay on the pads while the PUMA
 moves the board (after the Microbo has touched TP3, the PUMA carries it 40 mm along y).
 
+The constants are the C++'s, multiplied in the same order (the PUMA's goals folded into its
+base frame as the C++'s cell.in_base_of does), so the program prints the C++'s table.
+
 It measures, per pad, at every Microbo sample of the dwell: the distance between the Microbo's
 measured probe tip (forward kinematics of its joints, through its base and tool) and where the
 pad is at that instant (from the PUMA's joints of the same sample: base FK(q) TOOL GRASP PAD),
@@ -60,6 +63,14 @@ def rotation(axis, angle_rad):
     return T
 
 
+def rigid_inverse(T):
+    """T^-1 of a rigid transform (R^T, -R^T p), as rccx's Transform::inverse."""
+    inv = np.eye(4)
+    inv[:3, :3] = T[:3, :3].T
+    inv[:3, 3] = -(T[:3, :3].T @ T[:3, 3])
+    return inv
+
+
 def down_at(x_m, y_m, z_m):
     """The tool pointing down (approach -z) at a point of a frame whose z is up."""
     T = rotation("x", math.pi)
@@ -70,8 +81,8 @@ def down_at(x_m, y_m, z_m):
 def tool_in_board():
     """board <- PUMA tool: the fingers on the middle of the board's -x edge (5 mm in), the
     approach tilted 45 deg towards +x and turned 30 deg towards +y (see the C++ example)."""
-    return translation(-0.045, 0, 0) @ rotation("z", math.radians(30)) @ rotation(
-        "y", math.radians(135))
+    return translation(-0.045, 0, 0) @ (rotation("z", math.radians(30)) @ rotation(
+        "y", math.radians(135)))
 
 
 def default_cell():
@@ -143,7 +154,7 @@ def run(cell, args):
     presented = translation(0.060, 0, 0.140)
     presented_end = translation(0.060, TRAVEL_M, 0.140)
     tool_on_board = tool_in_board()
-    grasp_value = np.linalg.inv(tool_on_board)
+    grasp_value = rigid_inverse(tool_on_board)
 
     # Reachability, before anything moves: every goal solved within both arms' limits.
     puma_a, microbo_a = cell.robot("puma"), cell.robot("microbo")
@@ -187,10 +198,12 @@ def run(cell, args):
     T6 = rccx.t6()
     PTOOL = rccx.const("PTOOL", puma_tool)
     GRASP = rccx.const("GRASP", grasp_value)
-    PBASE_INV = cell.base_inv_transform("puma")
+    puma_base_inv = rigid_inverse(cell.base("puma"))
 
     def board_at(name, board):
-        return rccx.position(name, T6 * PTOOL * GRASP == PBASE_INV * rccx.const(name, board))
+        # The board's pose in the PUMA's base frame, one constant (as the C++'s in_base_of).
+        in_puma = rccx.const(f"{name}_in_puma", puma_base_inv @ board)
+        return rccx.position(name, T6 * PTOOL * GRASP == in_puma)
 
     p_over = board_at("OVER_BOARD", over_home)
     p_grip = board_at("ON_BOARD", board_home)
