@@ -90,10 +90,6 @@ class ThreadFeed:
 
     def __init__(self, arm, conv, lead_s, feed_s):
         self.arm = arm
-        # The first samples: before them the arm's joints (and so its configuration, which a
-        # joint move keeps) are not known yet in real time.
-        while arm.time < 3 * arm.period:
-            arm.wait_for(arm.period)
         self.offset_s = arm.time - time.monotonic()  # session time - host time, about
         self.stop = threading.Event()
 

@@ -443,6 +443,12 @@ RobotObject::RobotObject(const std::string& robot, const std::string& clock,
               rccl::Manipulator* a = &parts->arm;
               parts->robot.session->set_hangup_handler([a](rtc::Session&) { a->halt(); });
               parts->arm.start();
+              // Real time: return once a sample has been read, so that q and the arm's
+              // configuration (a joint move keeps it) are known to the first move().
+              if (o.clock == rtc::ClockKind::real_time) {
+                (void)parts->robot.session->wait_until([](const rtc::How& h) { return h.dof > 0; },
+                                                       std::chrono::seconds(2));
+              }
             }
             Parts* p = parts.get();
             owner->interrupt = [p] {

@@ -51,3 +51,13 @@ def test_bound_can_fail():
 
 def test_help():
     check_help("conveyor")
+
+
+def test_real_time_robot_knows_its_joints_at_once():
+    """rccx.Robot(clock="real_time") returns once a sample has been read: q and the arm's
+    configuration are known to the first move (which would otherwise take the arm as not yet
+    anywhere)."""
+    with rccx.Robot("puma560", clock="real_time") as arm:
+        k = arm.kinematics
+        assert arm.q.shape == (k.dof,) and arm.time > 0
+        assert k.configuration_of(arm.q) is not None
