@@ -7,8 +7,10 @@ calls that take (N, dof) joint arrays in one call.
 1. The Microbo's closed-form inverse puts the tool down at the four corners of the washer
    program (thesis 4.5.4.6); forward kinematics checks each answer (the same lines as the C++).
 2. The PUMA 560 reaches one pose in each of its eight configurations (the same joint values as
-   the C++; a configuration out of limits prints rccx's reason: Python has no limit-free copy of
-   a model, where the C++ names the joint that keeps it out).
+   the C++). For a configuration out of limits, a copy of the robot file without limits
+   (rccx.kin.robot_file) tells which joint keeps it out, as the C++ does with a copy of the
+   model; without the robot file (robots/puma560.json under $RCCX_ROBOTS_DIR or the source
+   tree) it prints rccx's reason.
 3. The Jacobian at that pose against central differences of forward kinematics.
 4. A batch: forward and Jacobian over N random configurations in one call each, against the
    per-configuration calls.
@@ -19,8 +21,12 @@ Run: PYTHONPATH=build/release/python python3 python/examples/kinematics.py [--ba
 """
 
 import argparse
+import json
 import math
+import os
+import pathlib
 import sys
+import tempfile
 import time
 
 import numpy as np
@@ -64,18 +70,52 @@ def microbo_corners():
     return worst
 
 
+def unlimited(name):
+    """The robot `name` without joint limits (+-720 deg), from its robot file; None when the
+    file is not at hand."""
+    for d in (os.environ.get("RCCX_ROBOTS_DIR"), pathlib.Path(__file__).resolve().parents[2] /
+              "robots"):
+        path = pathlib.Path(d or "") / f"{name}.json"
+        if d and path.is_file():
+            break
+    else:
+        return None
+    # Robot files allow // comment lines; JSON does not.
+    text = "\n".join(x for x in path.read_text().splitlines() if not x.lstrip().startswith("//"))
+    model = json.loads(text)
+    for j in model["joints"]:
+        j["lower_deg"], j["upper_deg"] = -720.0, 720.0
+    with tempfile.TemporaryDirectory() as tmp:
+        free = pathlib.Path(tmp) / f"{name}.json"
+        free.write_text(json.dumps(model))
+        return rccx.kin.robot_file(free)
+
+
 def puma_configurations():
     """One pose in each configuration; the largest FK(IK(T)) - T, m, and the pose's joints."""
     k = rccx.kin.robot("puma560")
     q0 = np.array([-0.8, 0.7, -2.6, 0.4, 0.9, -0.5])
     T = k.forward(q0)
     print(f"\n{k.title} - one pose, every configuration (from q = {joints_text(k, q0)}")
+    free = unlimited("puma560")
     worst = 0.0
     for name in k.configuration_names:
         try:
             q = k.inverse(T, configuration=name)
         except rccx.UnreachableError as e:
-            print(f"  {name}: {e}")
+            try:
+                q_free = free.inverse(T, configuration=name) if free else None
+            except rccx.UnreachableError:
+                q_free = None
+            outside = ([] if q_free is None else
+                       np.flatnonzero((q_free < k.lower) | (q_free > k.upper)))
+            if len(outside) == 0:
+                print(f"  {name}: {e}")
+                continue
+            j = outside[0]
+            print(f"  {name}: needs {k.joint_names[j]} = {math.degrees(q_free[j]):.1f} deg, "
+                  f"outside its limits {math.degrees(k.lower[j]):.0f} .. "
+                  f"{math.degrees(k.upper[j]):.0f} deg")
             continue
         worst = max(worst, np.abs(k.forward(q) - T).max())
         print(f"  {name}:{joints_text(k, q)}")
