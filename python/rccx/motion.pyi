@@ -149,7 +149,8 @@ class Arm:
     def hand_closed(self) -> bool: ...
 
 class Robot(Arm):
-    def __init__(self, robot: str = "microbo", clock: Literal["simulated", "real_time"] = ...,
+    def __init__(self, robot: Union[str, kin.Kinematics] = "microbo",
+                 clock: Literal["simulated", "real_time"] = ...,
                  period: Optional[float] = None, log: Optional[str] = None,
                  plant: Literal["automatic", "ideal", "servo", "mujoco"] = "automatic",
                  scene: Union[None, str, dict[str, Any]] = None) -> None:

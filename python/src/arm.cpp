@@ -390,21 +390,7 @@ struct RobotObject::Parts {
       : robot(std::move(model), options), arm(*robot.session) {}
 };
 
-namespace {
-kin::RobotModel model_of(const std::string& name) {
-  const auto names = kin::builtin_robot_names();
-  if (std::find(names.begin(), names.end(), name) == names.end()) {
-    try {
-      (void)kin::builtin_robot(name);  // its message lists the known names
-    } catch (const kin::RobotFileError& e) {
-      raise_key_error(e.what());
-    }
-  }
-  return kin::builtin_robot(name);
-}
-}  // namespace
-
-RobotObject::RobotObject(const std::string& robot, const std::string& clock,
+RobotObject::RobotObject(kin::RobotModel robot, const std::string& clock,
                          std::optional<double> period_s, const std::optional<std::string>& log,
                          const std::string& plant, const std::string& scene_json)
     : RobotObject(
@@ -413,7 +399,7 @@ RobotObject::RobotObject(const std::string& robot, const std::string& clock,
             o.clock = clock_of(clock);
             if (period_s) o.period = seconds_to_ns(*period_s, "period");
             if (log) o.log = *log;
-            kin::RobotModel model = model_of(robot);
+            kin::RobotModel model = std::move(robot);
             o.plant = plant_of(plant);
             if (!scene_json.empty()) {
               // A scene is the MuJoCo plant's: it implies that plant, and no other takes one.

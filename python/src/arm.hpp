@@ -152,7 +152,8 @@ class RobotObject : public ArmObject {
  public:
   /// plant: "automatic", "ideal", "servo" or "mujoco"; scene_json: the MuJoCo plant's scene as
   /// a robot file's "hardware": {"mujoco": ...} block (JSON text; empty: the file's).
-  RobotObject(const std::string& robot, const std::string& clock, std::optional<double> period_s,
+  /// robot: its model (a shipped robot's, a robot file's or a URDF's: rccx.kin).
+  RobotObject(kin::RobotModel robot, const std::string& clock, std::optional<double> period_s,
               const std::optional<std::string>& log, const std::string& plant = "automatic",
               const std::string& scene_json = "");
   /// Stops control and closes the session, its log put in place; raises LogError for a lost

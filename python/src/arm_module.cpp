@@ -8,6 +8,7 @@
 #include <memory>
 
 #include "arm.hpp"
+#include "kin.hpp"
 #include "rccl.hpp"
 #include "rccx/cell/cell_model.hpp"
 #include "rccx/rtc/sample_log.hpp"
@@ -321,13 +322,15 @@ void bind_rccl(py::module_& m) {
   py::class_<RobotObject, ArmObject>(
       m, "Robot",
       "A simulated robot (C++ rtc::SimulatedRobot + rccl::Manipulator), control started. "
-      "robot: a shipped robot's name; clock: \"simulated\" (deterministic, time runs while "
+      "robot: a shipped robot's name, or a rccx.kin.Kinematics (rccx.kin.robot_file, "
+      "rccx.kin.urdf: a robot file's or a URDF's model, its plant and scene with it); clock: "
+      "\"simulated\" (deterministic, time runs while "
       "the program waits) or \"real_time\"; period: s (None: the robot's usual one); log: a "
       "CSV of every sample (None: RCCX_LOG's, if set). close() (or with-block) ends control. "
       "plant: \"automatic\" (the robot file's), \"ideal\", \"servo\" or \"mujoco\" (a "
       "wrist sensor); scene: the MuJoCo plant's table, boxes and tool, a dict as a robot file's "
       "\"hardware\": {\"mujoco\": ...} (robots/README.md; ValueError naming a bad key).")
-      .def(py::init([](const std::string& robot, const std::string& clock,
+      .def(py::init([](const py::object& robot, const std::string& clock,
                        std::optional<double> period, const std::optional<std::string>& log,
                        const std::string& plant, const py::object& scene) {
              // A dict (the robot file's "mujoco" block) goes to C++ as its JSON text.
@@ -345,7 +348,20 @@ void bind_rccl(py::module_& m) {
                           .attr("dumps")(scene, py::arg("default") = as_list)
                           .cast<std::string>();
              }
-             return std::make_unique<RobotObject>(robot, clock, period, log, plant, json);
+             // A name, or a model from rccx.kin (robot_file, urdf: any robot rccx can load).
+             kin::RobotModel model;
+             if (py::isinstance<py::str>(robot)) {
+               model = builtin_model(robot.cast<std::string>());
+             } else if (py::isinstance<KinematicsObject>(robot)) {
+               model = robot.cast<const KinematicsObject&>().model();
+             } else {
+               throw py::type_error(
+                   "robot: a shipped robot's name or a rccx.kin.Kinematics "
+                   "(rccx.kin.robot_file, rccx.kin.urdf), not " +
+                   py::repr(robot).cast<std::string>());
+             }
+             return std::make_unique<RobotObject>(std::move(model), clock, period, log, plant,
+                                                  json);
            }),
            py::arg("robot") = "microbo", py::arg("clock") = "simulated",
            py::arg("period") = py::none(), py::arg("log") = py::none(),

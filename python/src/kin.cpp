@@ -287,7 +287,7 @@ std::vector<std::string> robot_names() {
   return kin::builtin_robot_names();
 }
 
-KinematicsObject robot(const std::string& name) {
+kin::RobotModel builtin_model(const std::string& name) {
   const auto names = kin::builtin_robot_names();
   if (std::find(names.begin(), names.end(), name) == names.end()) {
     try {
@@ -296,7 +296,11 @@ KinematicsObject robot(const std::string& name) {
       raise_key_error(e.what());
     }
   }
-  return KinematicsObject(kin::builtin_robot(name));
+  return kin::builtin_robot(name);
+}
+
+KinematicsObject robot(const std::string& name) {
+  return KinematicsObject(builtin_model(name));
 }
 
 namespace {

@@ -63,6 +63,8 @@ class KinematicsObject {
 
 std::vector<std::string> robot_names();
 /// A shipped robot; an unknown name raises KeyError listing the known ones.
+/// A shipped robot's model by name; KeyError naming the known ones.
+kin::RobotModel builtin_model(const std::string& name);
 KinematicsObject robot(const std::string& name);
 /// A robot file (JSON, robots/README.md); a missing file raises FileNotFoundError.
 KinematicsObject robot_file(const std::filesystem::path& path);
