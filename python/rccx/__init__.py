@@ -26,3 +26,8 @@ __all__ += ["Arm", "Cell", "CellFileError", "Equation", "EquationError", "Event"
             "LogError", "Motion", "MotionError", "Position", "Product", "Robot", "SessionError",
             "Stream", "Together", "Transform", "When", "const", "hold", "joints", "position",
             "stream", "t6"]
+# The web page of a running program (docs/PYTHON.md, "Watching a program").
+from ._rccx import ViewError
+from . import view
+
+__all__ += ["ViewError", "view"]

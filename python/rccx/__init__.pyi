@@ -41,3 +41,10 @@ __all__ += ["Arm", "Cell", "CellFileError", "Equation", "EquationError", "Event"
             "LogError", "Motion", "MotionError", "Position", "Product", "Robot", "SessionError",
             "Stream", "Together", "Transform", "When", "const", "hold", "joints", "position",
             "stream", "t6"]
+# The web page of a running program (rccx/view.pyi).
+from . import view as view
+
+class ViewError(RuntimeError):
+    """The view cannot start (port in use, address, a robot another view serves) or is closed."""
+
+__all__ += ["ViewError", "view"]

@@ -105,6 +105,9 @@ class ArmObject {
   [[nodiscard]] OutArray joints() const;
   [[nodiscard]] const std::string& name() const noexcept { return name_; }
   [[nodiscard]] std::string repr() const;
+  /// For rccx.view (view.cpp): what keeps the arm alive, and the arm.
+  [[nodiscard]] const std::shared_ptr<Owner>& owner() const noexcept { return owner_; }
+  [[nodiscard]] rccl::Manipulator& manipulator() const noexcept { return *arm_; }
 
   /// Runs `step(slice)` (the GIL released, the planning lock taken) until it returns true or
   /// `timeout` has passed (false); between slices checks for signals (Ctrl-C: interrupts the
@@ -182,6 +185,9 @@ class CellObject {
   /// A joint start of `robots`; its when(robot) goes to each robot's move.
   TogetherObject together(const std::vector<std::string>& robots, bool end_together);
   void close();
+  /// For rccx.view (view.cpp): what keeps the cell alive, and the cell.
+  [[nodiscard]] const std::shared_ptr<Owner>& owner() const noexcept { return owner_; }
+  [[nodiscard]] cell::Cell& cell() const noexcept { return *cell_; }
 
  private:
   template <class F>
