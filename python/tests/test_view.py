@@ -206,7 +206,8 @@ def test_a_cells_robots(assets):
         with rccx.view.serve(cell.robot(names[0]), port=0, announce=False,
                              assets=assets) as one:
             robots = get_json(one, "/api/scene")["robots"]
-            assert len(robots) == 1 and len(robots[0]["joints"]) == cell.robot(names[0]).kinematics.dof
+            assert len(robots) == 1
+            assert len(robots[0]["joints"]) == cell.robot(names[0]).kinematics.dof
 
 
 def motions_goal(arm):
