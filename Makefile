@@ -84,7 +84,7 @@ bench: build-release
 # "Speed"): the C++ peers (BENCH_PYTHON_CPP, a benchmark filter) and python/bench/run.py in the
 # same run, both into bench-results/, then the ratios and goals. The interpreter is the one the
 # module was built for (the build's Python3_EXECUTABLE).
-BENCH_PYTHON_CPP ?= ^BM_Puma560FK$$|^BM_KdlPuma560FK$$
+BENCH_PYTHON_CPP ?= ^BM_Puma560FK$$|^BM_KdlPuma560FK$$|^BM_MoveToFirstSetpoint/
 .PHONY: bench-python
 bench-python: deps $(RELEASE_DIR)/CMakeCache.txt
 	$(CMAKE) --build $(RELEASE_DIR) -j$(JOBS) --target rccx_bench rccx_python

@@ -31,3 +31,8 @@ __all__ += ["Arm", "Cell", "CellFileError", "Equation", "EquationError", "Event"
 from ._rccx import external_wrench, wrench_at_tool
 
 __all__ += ["external_wrench", "wrench_at_tool"]
+# The web page of a running program (docs/PYTHON.md, "Watching a program").
+from ._rccx import ViewError
+from . import view
+
+__all__ += ["ViewError", "view"]

@@ -45,3 +45,10 @@ __all__ += ["Arm", "Cell", "CellFileError", "Equation", "EquationError", "Event"
 from .motion import external_wrench as external_wrench, wrench_at_tool as wrench_at_tool
 
 __all__ += ["external_wrench", "wrench_at_tool"]
+# The web page of a running program (rccx/view.pyi).
+from . import view as view
+
+class ViewError(RuntimeError):
+    """The view cannot start (port in use, address, a robot another view serves) or is closed."""
+
+__all__ += ["ViewError", "view"]

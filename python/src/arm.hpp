@@ -105,6 +105,9 @@ class ArmObject {
   [[nodiscard]] OutArray joints() const;
   [[nodiscard]] const std::string& name() const noexcept { return name_; }
   [[nodiscard]] std::string repr() const;
+  /// For rccx.view (view.cpp): what keeps the arm alive, and the arm.
+  [[nodiscard]] const std::shared_ptr<Owner>& owner() const noexcept { return owner_; }
+  [[nodiscard]] rccl::Manipulator& manipulator() const noexcept { return *arm_; }
 
   // Force (issue 15) from Python (python/examples/touch_and_wipe.py): a robot with a wrist
   // sensor (rccx.Robot(plant="mujoco")).
@@ -209,6 +212,9 @@ class CellObject {
   [[nodiscard]] double period_s() const;
   /// Times the collision check stopped the arms.
   [[nodiscard]] std::uint64_t collision_stops() const;
+  /// For rccx.view (view.cpp): what keeps the cell alive, and the cell.
+  [[nodiscard]] const std::shared_ptr<Owner>& owner() const noexcept { return owner_; }
+  [[nodiscard]] cell::Cell& cell() const noexcept { return *cell_; }
 
  private:
   template <class F>

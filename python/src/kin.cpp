@@ -121,7 +121,17 @@ std::size_t KinematicsObject::dof() const noexcept {
   return k_->dof();
 }
 
-OutArray KinematicsObject::forward(const InArray& q) const {
+OutArray KinematicsObject::forward(py::handle q_arg) const {
+  // One configuration as a float64 array, the common call: read in place, the same checks
+  // (the shape by f64_vector, finite values here), the pose written into the new (4, 4).
+  if (const double* v = f64_vector(q_arg, k_->dof())) {
+    if (!all_finite(v, k_->dof())) raise_value_error("forward: a joint value is not finite");
+    OutArray out = new_array({4, 4});
+    write_transform(k_->forward(kin::JointVector(std::span<const double>(v, k_->dof()))),
+                    out.mutable_data());
+    return out;
+  }
+  const InArray q = to_in_array(q_arg, "forward");
   if (ndim(q) == 1) {
     const kin::JointVector v = joints_from(*k_, q, "forward");
     OutArray out = new_array({4, 4});

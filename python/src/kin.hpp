@@ -30,8 +30,9 @@ class KinematicsObject {
   [[nodiscard]] const kin::RobotModel& model() const noexcept;
   [[nodiscard]] std::size_t dof() const noexcept;
 
-  /// q (dof,) -> T6 (4, 4); q (N, dof) -> (N, 4, 4), the GIL released.
-  [[nodiscard]] OutArray forward(const InArray& q) const;
+  /// q (dof,) -> T6 (4, 4); q (N, dof) -> (N, 4, 4), the GIL released. Any array-like q: a
+  /// float64 (dof,) array is read in place (the common call, kept cheap), others converted.
+  [[nodiscard]] OutArray forward(py::handle q) const;
   /// q (dof,) -> (6, dof); q (N, dof) -> (N, 6, dof).
   [[nodiscard]] OutArray jacobian(const InArray& q) const;
   /// q (dof,) within limits; throws UnreachableError.

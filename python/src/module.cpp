@@ -20,6 +20,10 @@ using rccx::python::KinematicsObject;
 namespace rccx::python {
 void bind_rccl(py::module_& m);
 }
+// rccx.view, the web page of a running program (view.cpp).
+namespace rccx::python {
+void bind_view(py::module_& m);
+}
 
 namespace {
 
@@ -137,4 +141,5 @@ PYBIND11_MODULE(_rccx, m) {
   rccx::python::bind_data(m);  // rccx.log, rccx.plot, rccx.db
   // Position equations, robots and cells (arm_module.cpp); after kin: Arm.kinematics returns one.
   rccx::python::bind_rccl(m);
+  rccx::python::bind_view(m);  // rccx.view: after bind_rccl (serve takes a Robot or a Cell)
 }
