@@ -101,6 +101,20 @@ math::Wrench wrench_of(const std::optional<InArray>& a, const char* what) {
   return math::Wrench::from_array(w);
 }
 
+/// The tool's load (force::ToolLoad) from Python: kg (finite, >= 0), its centre of mass (3,) m
+/// in T6, the sensor's bias (6,) N and N m.
+force::ToolLoad tool_load_of(double mass_kg, const std::optional<InArray>& com_m,
+                             const std::optional<InArray>& bias) {
+  if (!std::isfinite(mass_kg) || mass_kg < 0.0) {
+    raise_value_error(fmt::format("mass_kg must be a finite number >= 0, got {}", mass_kg));
+  }
+  force::ToolLoad load;
+  load.mass_kg = mass_kg;
+  load.com_m = vec3_of(com_m, "com_m");
+  load.bias = wrench_of(bias, "bias");
+  return load;
+}
+
 OutArray wrench_out(const math::Wrench& w) {
   const std::array<double, 6> a = w.to_array();
   return to_array(a);
@@ -352,13 +366,7 @@ std::string ArmObject::repr() const {
 
 void ArmObject::set_tool_load(double mass_kg, const std::optional<InArray>& com_m,
                               const std::optional<InArray>& bias) {
-  if (!std::isfinite(mass_kg) || mass_kg < 0.0) {
-    raise_value_error(fmt::format("mass_kg must be a finite number >= 0, got {}", mass_kg));
-  }
-  force::ToolLoad load;
-  load.mass_kg = mass_kg;
-  load.com_m = vec3_of(com_m, "com_m");
-  load.bias = wrench_of(bias, "bias");
+  const force::ToolLoad load = tool_load_of(mass_kg, com_m, bias);
   locked([&] { arm_->set_tool_load(load); });
 }
 
@@ -618,13 +626,7 @@ std::uint64_t CellObject::collision_stops() const {
 
 OutArray external_wrench(const InArray& reading, const InArray& world_from_t6, double mass_kg,
                          const std::optional<InArray>& com_m, const std::optional<InArray>& bias) {
-  if (!std::isfinite(mass_kg) || mass_kg < 0.0) {
-    raise_value_error(fmt::format("mass_kg must be a finite number >= 0, got {}", mass_kg));
-  }
-  force::ToolLoad load;
-  load.mass_kg = mass_kg;
-  load.com_m = vec3_of(com_m, "com_m");
-  load.bias = wrench_of(bias, "bias");
+  const force::ToolLoad load = tool_load_of(mass_kg, com_m, bias);
   const math::Transform T = transform_in(world_from_t6, "world_from_t6");
   return wrench_out(force::external_wrench(load, T.R, wrench_of(reading, "reading")));
 }

@@ -19,13 +19,6 @@ namespace rccx::python {
 
 namespace {
 
-template <typename E>
-void add_exception(py::module_& m, const char* name, PyObject* base, const char* doc) {
-  auto e = py::register_exception<E>(m, name, base);
-  e.attr("__module__") = "rccx";
-  e.attr("__doc__") = doc;
-}
-
 py::dict motion_event_dict(const rccl::MotionEvent& e) {
   py::dict d;
   d["kind"] = std::string(rccl::to_string(e.kind));

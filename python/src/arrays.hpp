@@ -99,4 +99,14 @@ using ReleaseGil = py::gil_scoped_release;
   throw py::error_already_set();
 }
 
+/// Registers a C++ exception type as a Python exception of module rccx deriving from `bases`
+/// (a type or a tuple of types); what() becomes its message.
+template <typename E>
+py::object add_exception(py::module_& m, const char* name, py::handle bases, const char* doc) {
+  auto e = py::register_exception<E>(m, name, bases.ptr());
+  e.attr("__module__") = "rccx";
+  e.attr("__doc__") = doc;
+  return e;
+}
+
 }  // namespace rccx::python

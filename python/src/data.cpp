@@ -2,6 +2,7 @@
 // view::path_errors_m, view::run_plot and rccl::PositionDb. Their errors are rccx's exceptions
 // (RunLogError, DatabaseError ...), which module.cpp registers as Python exceptions.
 #include "data.hpp"
+#include "transform.hpp"
 
 #include <fmt/format.h>
 
@@ -120,24 +121,11 @@ namespace {
 /// A (4, 4) homogeneous transform (m) from Python; its rigidity is PositionDb::check's to judge
 /// (InvalidTransform with rccx's message), the shape and the last row are checked here.
 math::Transform transform_from(const InArray& a, const std::string& name) {
+  std::string why;
+  const std::optional<math::Transform> T = homogeneous(a, why);
   // As PositionDb::check words its refusals.
-  const auto refuse = [&](const std::string& why) {
-    throw rccl::InvalidTransform(fmt::format("transform {}: {}", io::quoted(name), why));
-  };
-  if (ndim(a) != 2 || extent(a, 0) != 4 || extent(a, 1) != 4) {
-    refuse(
-        fmt::format("T must be a (4, 4) homogeneous transform (m), got shape {}", shape_text(a)));
-  }
-  const double* m = a.data();
-  if (!std::all_of(m, m + 16, [](double x) { return std::isfinite(x); })) {
-    refuse("T has a non-finite element");
-  }
-  if (m[12] != 0.0 || m[13] != 0.0 || m[14] != 0.0 || m[15] != 1.0) {
-    refuse(
-        fmt::format("T's last row must be 0 0 0 1, got {} {} {} {}", m[12], m[13], m[14], m[15]));
-  }
-  return math::Transform::from_rows(
-      {m[0], m[1], m[2], m[3], m[4], m[5], m[6], m[7], m[8], m[9], m[10], m[11]});
+  if (!T) throw rccl::InvalidTransform(fmt::format("transform {}: {}", io::quoted(name), why));
+  return *T;
 }
 
 rccl::StoredTransform stored(const std::string& robot, const std::string& name, const InArray& T,

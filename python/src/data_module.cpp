@@ -11,19 +11,7 @@ namespace py = pybind11;
 
 namespace rccx::python {
 
-namespace {
-
-/// A C++ exception type as a Python exception of module rccx deriving from `bases` (a type or a
-/// tuple of types).
-template <typename E>
-py::object add_exception(py::module_& m, const char* name, py::handle bases, const char* doc) {
-  auto e = py::register_exception<E>(m, name, bases.ptr());
-  e.attr("__module__") = "rccx";
-  e.attr("__doc__") = doc;
-  return e;
-}
-
-}  // namespace
+namespace {}  // namespace
 
 void bind_data(py::module_& m) {
   add_exception<view::RunLogError>(

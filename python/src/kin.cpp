@@ -2,6 +2,7 @@
 // kin::Kinematics: joint values and transforms checked and copied between NumPy arrays and
 // JointVector / math::Transform, C++ errors turned into Python exceptions with rccx's messages.
 #include "kin.hpp"
+#include "transform.hpp"
 
 #include <fmt/format.h>
 
@@ -22,47 +23,6 @@ namespace {
 
 std::string unit_of(const kin::Joint& j) {
   return j.type == kin::JointType::revolute ? "rad" : "m";
-}
-
-bool all_finite(const double* v, std::size_t n) {
-  return std::all_of(v, v + n, [](double x) { return std::isfinite(x); });
-}
-
-/// T as a (4, 4) array, m.
-void write_transform(const math::Transform& T, double* out) {
-  for (int r = 0; r < 4; ++r) {
-    for (int c = 0; c < 4; ++c) *out++ = T(r, c);
-  }
-}
-
-/// A (4, 4) homogeneous transform (m) from Python: finite, last row 0 0 0 1, its rotation part
-/// orthonormal and right-handed within 1e-6 as `rccx kin ik --T` requires.
-math::Transform transform_from(const InArray& a, const char* what) {
-  if (ndim(a) != 2 || extent(a, 0) != 4 || extent(a, 1) != 4) {
-    raise_value_error(fmt::format("{}: T must be a (4, 4) homogeneous transform (m), got shape {}",
-                                  what, shape_text(a)));
-  }
-  const double* m = a.data();
-  if (!all_finite(m, 16)) raise_value_error(fmt::format("{}: T has a non-finite element", what));
-  if (m[12] != 0.0 || m[13] != 0.0 || m[14] != 0.0 || m[15] != 1.0) {
-    raise_value_error(fmt::format("{}: T's last row must be 0 0 0 1, got {} {} {} {}", what, m[12],
-                                  m[13], m[14], m[15]));
-  }
-  const math::Transform T = math::Transform::from_rows(
-      {m[0], m[1], m[2], m[3], m[4], m[5], m[6], m[7], m[8], m[9], m[10], m[11]});
-  const math::Rot3 RtR = T.R.transposed() * T.R;
-  double error = 0.0;
-  for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) error = std::max(error, std::abs(RtR(r, c) - (r == c ? 1.0 : 0.0)));
-  }
-  const double det = math::dot(math::cross(T.R.n, T.R.o), T.R.a);
-  if (error > 1e-6 || det < 0) {
-    raise_value_error(fmt::format(
-        "{}: T's rotation part is not a rotation matrix (|RtR - I| = {:.2g}, det = {:.6g}); give "
-        "an orthonormal, right-handed frame",
-        what, error, det));
-  }
-  return T;
 }
 
 [[noreturn]] void raise_joint_shape(const kin::Kinematics& k, const InArray& a, const char* what,
@@ -223,7 +183,7 @@ OutArray KinematicsObject::inverse(const InArray& T,
                                    const std::optional<std::string>& configuration,
                                    const std::optional<InArray>& near,
                                    std::optional<double> redundant) const {
-  const math::Transform pose = transform_from(T, "inverse");
+  const math::Transform pose = transform_in(T, "inverse");
   const kin::IkOptions o = options(configuration, near, redundant, "inverse");
   kin::IkResult r;
   {
@@ -236,7 +196,7 @@ OutArray KinematicsObject::inverse(const InArray& T,
 
 std::vector<std::pair<std::optional<std::string>, OutArray>> KinematicsObject::inverse_all(
     const InArray& T, const std::optional<InArray>& near) const {
-  const math::Transform pose = transform_from(T, "inverse_all");
+  const math::Transform pose = transform_in(T, "inverse_all");
   const kin::IkOptions o = options(std::nullopt, near, std::nullopt, "inverse_all");
   kin::IkSolutions all;
   {

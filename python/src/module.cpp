@@ -27,14 +27,6 @@ void bind_view(py::module_& m);
 
 namespace {
 
-/// Registers a C++ exception type as a Python exception of module rccx deriving from `base`.
-template <typename E>
-void add_exception(py::module_& m, const char* name, PyObject* base, const char* doc) {
-  auto e = py::register_exception<E>(m, name, base);
-  e.attr("__module__") = "rccx";
-  e.attr("__doc__") = doc;
-}
-
 constexpr const char* kForwardDoc = R"(T6, the last link's frame in the base frame.
 
 q: joint values, rad (revolute) or m (prismatic): shape (dof,), or (N, dof) for N

@@ -13,10 +13,6 @@ namespace rccx::python {
 
 namespace {
 
-bool all_finite(const double* v, std::size_t n) {
-  return std::all_of(v, v + n, [](double x) { return std::isfinite(x); });
-}
-
 std::int64_t steady_ns() {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(
              std::chrono::steady_clock::now().time_since_epoch())
@@ -24,37 +20,6 @@ std::int64_t steady_ns() {
 }
 
 }  // namespace
-
-math::Transform transform_in(const InArray& a, const std::string& what) {
-  if (ndim(a) != 2 || extent(a, 0) != 4 || extent(a, 1) != 4) {
-    raise_value_error(fmt::format("{}: T must be a (4, 4) homogeneous transform (m), got shape {}",
-                                  what, shape_text(a)));
-  }
-  const double* m = a.data();
-  if (!all_finite(m, 16)) raise_value_error(fmt::format("{}: T has a non-finite element", what));
-  if (m[12] != 0.0 || m[13] != 0.0 || m[14] != 0.0 || m[15] != 1.0) {
-    raise_value_error(fmt::format("{}: T's last row must be 0 0 0 1, got {} {} {} {}", what, m[12],
-                                  m[13], m[14], m[15]));
-  }
-  const math::Transform T = math::Transform::from_rows(
-      {m[0], m[1], m[2], m[3], m[4], m[5], m[6], m[7], m[8], m[9], m[10], m[11]});
-  if (!rccl::is_rigid(T)) {
-    raise_value_error(fmt::format(
-        "{}: T's rotation part is not a rotation matrix; give an orthonormal, right-handed frame "
-        "(within 1e-6)",
-        what));
-  }
-  return T;
-}
-
-OutArray transform_out(const math::Transform& T) {
-  OutArray out = new_array({4, 4});
-  double* o = out.mutable_data();
-  for (int r = 0; r < 4; ++r) {
-    for (int c = 0; c < 4; ++c) *o++ = T(r, c);
-  }
-  return out;
-}
 
 rccl::TransformPtr make_constant(const std::string& name, const InArray& T) {
   return rccl::constant(name, transform_in(T, "const " + name));

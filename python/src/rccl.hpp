@@ -15,14 +15,9 @@
 #include "rccx/cell/seqlock.hpp"
 #include "rccx/rccl/position.hpp"
 #include "rccx/rccl/transforms.hpp"
+#include "transform.hpp"
 
 namespace rccx::python {
-
-/// A (4, 4) homogeneous transform (m) from Python: finite, last row 0 0 0 1, an orthonormal
-/// right-handed rotation within 1e-6; ValueError naming `what` otherwise.
-math::Transform transform_in(const InArray& a, const std::string& what);
-/// T as a new (4, 4) float64 array.
-OutArray transform_out(const math::Transform& T);
 
 rccl::TransformPtr make_constant(const std::string& name, const InArray& T);
 rccl::TransformPtr make_hold(const std::string& name, const std::optional<InArray>& T);

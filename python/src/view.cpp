@@ -170,13 +170,10 @@ a robot another view serves; rccx.SessionError for a closed robot.)";
 void bind_view(py::module_& m) {
   py::module_ v = m.def_submodule(
       "view", "The web page of robots at work (C++ rccx::view), served from this program.");
-  {
-    auto e = py::register_exception<view::ViewError>(m, "ViewError", PyExc_RuntimeError);
-    e.attr("__module__") = "rccx";
-    e.attr("__doc__") =
-        "The view cannot start (a port in use, an address that cannot be bound, a robot another "
-        "view serves) or is closed; the message says what to do.";
-  }
+  add_exception<view::ViewError>(
+      m, "ViewError", PyExc_RuntimeError,
+      "The view cannot start (a port in use, an address that cannot be bound, a robot another "
+      "view serves) or is closed; the message says what to do.");
   py::class_<ViewObject>(v, "Server",
                          "A running view (C++ rccx::view::Server): its page at .url until "
                          "close(). Made by rccx.view.serve.")
