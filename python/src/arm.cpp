@@ -311,6 +311,9 @@ double ArmObject::time_s() const {
 OutArray ArmObject::joints() const {
   return to_array(arm_->session().how().q().span());
 }
+bool ArmObject::hand_closed() const {
+  return arm_->session().how().hand_closed;
+}
 std::string ArmObject::repr() const {
   return fmt::format("<rccx robot {} ({}), {}>", name_, arm_->kinematics().model().name,
                      owner_->closed ? "closed" : (controlling() ? "in control" : "not in control"));

@@ -103,6 +103,8 @@ class ArmObject {
   /// The last sample read: its time (s since the session opened) and measured joints.
   [[nodiscard]] double time_s() const;
   [[nodiscard]] OutArray joints() const;
+  /// The hand as the last sample read it (How::hand_closed): set_hand's effect, a sample on.
+  [[nodiscard]] bool hand_closed() const;
   [[nodiscard]] const std::string& name() const noexcept { return name_; }
   [[nodiscard]] std::string repr() const;
 

@@ -271,6 +271,8 @@ void bind_rccl(py::module_& m) {
                              "The last sample's time, s since the session opened.")
       .def_property_readonly("q", &ArmObject::joints,
                              "The measured joints of the last sample (dof,), rad or m.")
+      .def_property_readonly("hand_closed", &ArmObject::hand_closed,
+                             "The hand as the last sample read it (set_hand acts a sample on).")
       .def("__repr__", &ArmObject::repr);
 
   py::class_<RobotObject, ArmObject>(
