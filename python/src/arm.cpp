@@ -81,6 +81,17 @@ nanoseconds slice_of(nanoseconds period) {
 
 constexpr nanoseconds kForever = std::chrono::hours(24 * 365);
 
+/// ValueError for an event of a motion of another arm than `arm` (named `name`).
+void check_event_of(const EventObject& event, const rccl::Manipulator* arm, const std::string& name,
+                    const char* what) {
+  if (event.arm != nullptr && event.arm != arm) {
+    raise_value_error(fmt::format(
+        "{}: {} is an event of robot {}'s motion, not of {}'s (motion ids are each robot's "
+        "own): ask {}, or wait for several robots with cell.waitfor(cell.event(robot, event))",
+        what, event.repr(), event.robot, name, event.robot));
+  }
+}
+
 }  // namespace
 
 std::string EventObject::repr() const {
@@ -216,9 +227,21 @@ void ArmObject::set_compliance(const std::vector<py::object>& axes,
   locked([&] { arm_->set_compliance(c); });
 }
 
+void ArmObject::check_mine(const EventObject& event, const char* what) const {
+  check_event_of(event, arm_, name_, what);
+}
+
 rccl::StartWhen ArmObject::start_when(const std::vector<WhenObject>& when) const {
   rccl::StartWhen w;
   for (const WhenObject& o : when) {
+    // The gates point into their cell's motion ledgers: another cell's (or a cell's for a
+    // robot of its own) would be read after that cell is gone, and never open meanwhile.
+    if (o.owner != owner_) {
+      raise_value_error(fmt::format(
+          "after: an event of another cell: robot {}'s motion may wait only for robots of its "
+          "own cell",
+          name_));
+    }
     w.after.insert(w.after.end(), o.when.after.begin(), o.when.after.end());
     w.touch |= o.when.touch;
     if (o.when.together) {
@@ -234,12 +257,12 @@ MotionObject ArmObject::move(const rccl::PositionPtr& position,
                              const std::vector<WhenObject>& when) {
   if (!position) raise_value_error("move: no position given");
   const rccl::StartWhen w = start_when(when);
-  return {locked([&] { return arm_->move(position, w); })};
+  return {locked([&] { return arm_->move(position, w); }), arm_, name_};
 }
 
 MotionObject ArmObject::dwell(double seconds, const std::vector<WhenObject>& when) {
   const rccl::StartWhen w = start_when(when);
-  return {locked([&] { return arm_->dwell(seconds, w); })};
+  return {locked([&] { return arm_->dwell(seconds, w); }), arm_, name_};
 }
 
 void ArmObject::halt() {
@@ -261,6 +284,7 @@ EventObject ArmObject::ended(const rccl::PositionPtr& p) const {
 }
 
 std::string ArmObject::waitfor(const EventObject& event, std::optional<double> timeout_s) {
+  check_mine(event, "waitfor");
   check_open();
   rccl::WaitResult r = rccl::WaitResult::timeout;
   sliced_wait(*owner_, timeout_s, arm_->session().period(), [&](nanoseconds d) {
@@ -284,6 +308,7 @@ std::optional<std::string> ArmObject::wait_for(double seconds) {
 }
 
 bool ArmObject::happened(const EventObject& event) {
+  check_mine(event, "happened");
   return locked([&] { return arm_->happened(event.event); });
 }
 
@@ -294,6 +319,7 @@ std::vector<rccl::MotionEvent> ArmObject::take_events() {
   return locked([&] { return arm_->take_events(); });
 }
 rccl::SegmentReport ArmObject::report(const MotionObject& m) {
+  check_mine(m.end(), "report");
   return locked([&] { return arm_->report(m.motion); });
 }
 std::uint64_t ArmObject::last_queued() {
@@ -442,11 +468,19 @@ std::vector<std::string> CellObject::robot_names() const {
   return cell_->robot_names();
 }
 
+void CellObject::check_robot(const std::string& robot, const EventObject& event, const char* what) {
+  // cell_->robot names the cell's robots for an unknown name.
+  const rccl::Manipulator* m = locked([&] { return &cell_->robot(robot); });
+  check_event_of(event, m, robot, what);
+}
+
 GateObject CellObject::event(const std::string& robot, const EventObject& event) {
+  check_robot(robot, event, "cell.event");
   return {locked([&] { return cell_->event(robot, event.event); }), owner_};
 }
 
 WhenObject CellObject::after(const std::string& robot, const EventObject& event) {
+  check_robot(robot, event, "cell.after");
   return {locked([&] { return cell_->after(robot, event.event); }), owner_};
 }
 

@@ -47,13 +47,19 @@ struct Owner {
 struct EventObject {
   rccl::Event event;
   rccl::PositionPtr position;
+  /// A motion's start or end: the arm whose motion it is (motion ids are an arm's own), so
+  /// that another arm's wait refuses it; null for completed() and ended(p).
+  const rccl::Manipulator* arm = nullptr;
+  std::string robot{};
   [[nodiscard]] std::string repr() const;
 };
 
 struct MotionObject {
   rccl::Motion motion;
-  [[nodiscard]] EventObject start() const { return {motion.start(), nullptr}; }
-  [[nodiscard]] EventObject end() const { return {motion.end(), nullptr}; }
+  const rccl::Manipulator* arm = nullptr;  ///< the arm that queued it
+  std::string robot{};
+  [[nodiscard]] EventObject start() const { return {motion.start(), nullptr, arm, robot}; }
+  [[nodiscard]] EventObject end() const { return {motion.end(), nullptr, arm, robot}; }
 };
 
 /// What a queued motion waits for (rccl::StartWhen): other robots' events, a joint start, the
@@ -127,6 +133,8 @@ class ArmObject {
  protected:
   void check_open() const;
   rccl::StartWhen start_when(const std::vector<WhenObject>& when) const;
+  /// ValueError for an event of another arm's motion (`what`: the call).
+  void check_mine(const EventObject& event, const char* what) const;
 
   std::shared_ptr<Owner> owner_;
   rccl::Manipulator* arm_;
@@ -170,6 +178,8 @@ class CellObject {
   void start();
   ArmObject robot(const std::string& name);
   [[nodiscard]] std::vector<std::string> robot_names() const;
+  /// ValueError for an event of another robot's motion than `robot`'s.
+  void check_robot(const std::string& robot, const EventObject& event, const char* what);
   GateObject event(const std::string& robot, const EventObject& event);
   WhenObject after(const std::string& robot, const EventObject& event);
   WhenObject touching(const std::vector<std::string>& objects);

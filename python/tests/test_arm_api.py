@@ -390,3 +390,33 @@ def test_cell_errors_name_what_there_is(tmp_path):
         ' "base": {"xyz_m": [0, 0, 0]}}], "objects": []}')
     with pytest.raises(rccx.CellFileError, match="unknown_robot.json"):
         rccx.Cell(str(unknown))
+
+
+def test_events_belong_to_their_robot():
+    # Motion ids are each arm's own (C++ Motion{id}): another robot's motion's event would name
+    # a motion of its own, or none, so it is refused, as are gates of another cell (they point
+    # into that cell's ledgers, which need not outlive the motion that waits on them).
+    with rccx.Cell(CELL) as cell:
+        cell.start()
+        puma, microbo = cell.robot("puma"), cell.robot("microbo")
+        m = puma.move(rccx.joints("P", puma.kinematics.ready + 0.05))
+        mine = microbo.move(rccx.joints("M", microbo.kinematics.ready))
+        assert m.id == mine.id == 1  # the same id, two motions
+        for call in (lambda: microbo.waitfor(m.end, timeout=1), lambda: microbo.happened(m.start),
+                     lambda: microbo.report(m), lambda: cell.event("microbo", m.end),
+                     lambda: cell.after("microbo", m.end)):
+            with pytest.raises(ValueError, match="robot puma's motion"):
+                call()
+        assert puma.waitfor(m.end, timeout=10) == "reached"
+        assert cell.waitfor(cell.event("microbo", mine.end), timeout=10) == "reached"
+        # completed() and ended(p) name no motion: any robot's own
+        assert microbo.waitfor(puma.completed(), timeout=1) == "reached"
+        with rccx.Robot("puma560") as arm, rccx.Cell(CELL) as other:
+            other.start()
+            for after in (cell.event("puma", m.end), cell.after("puma", m.end),
+                          cell.touching(["board"]), [cell.event("puma", m.end)]):
+                with pytest.raises(ValueError, match="another cell"):
+                    arm.move(arm.park, after=after)
+                with pytest.raises(ValueError, match="another cell"):
+                    other.robot("puma").dwell(0.1, after=after)
+            assert arm.last_queued == 0 and other.robot("puma").last_queued == 0
