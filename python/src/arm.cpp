@@ -374,7 +374,14 @@ RobotObject::RobotObject(const std::string& robot, const std::string& clock,
           [&] {
             rtc::SimulatedRobotOptions o;
             o.clock = clock_of(clock);
-            if (period_s) o.period = seconds_to_ns(*period_s, "period");
+            if (period_s) {
+              // 0 would silently mean the robot's usual period (SessionOptions' default).
+              if (!(*period_s > 0.0)) {
+                raise_value_error(fmt::format(
+                    "period must be > 0 s (None: the robot's usual one), got {}", *period_s));
+              }
+              o.period = seconds_to_ns(*period_s, "period");
+            }
             if (log) o.log = *log;
             kin::RobotModel model = model_of(robot);
             auto owner = std::make_shared<Owner>();

@@ -420,3 +420,18 @@ def test_events_belong_to_their_robot():
                 with pytest.raises(ValueError, match="another cell"):
                     other.robot("puma").dwell(0.1, after=after)
             assert arm.last_queued == 0 and other.robot("puma").last_queued == 0
+
+
+def test_bad_arguments_raise_clear_errors():
+    with pytest.raises(ValueError, match="period must be > 0"):
+        rccx.Robot("puma560", period=0.0)
+    with pytest.raises(rccx.SessionError, match="outside"):
+        rccx.Robot("puma560", period=1e-6)
+    with rccx.Cell(CELL) as cell:
+        cell.start()
+        puma = cell.robot("puma")
+        m = puma.move(rccx.joints("P", puma.kinematics.ready + 0.05))
+        for bad in ([m.end], m.end, 5, [cell.event("puma", m.end), None]):
+            with pytest.raises(TypeError, match=r"cell\.event\(robot, event\)"):
+                cell.waitfor(bad)
+        assert cell.waitfor((cell.event("puma", m.end),), timeout=10) == "reached"
