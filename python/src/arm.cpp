@@ -81,6 +81,23 @@ nanoseconds slice_of(nanoseconds period) {
 
 constexpr nanoseconds kForever = std::chrono::hours(24 * 365);
 
+/// After a halt(): waits (at most `timeout`) until its motions have ended (the halt fails the
+/// running one as it begins) and then until the arm's measured joints stand still, so that
+/// control ends with the arm at rest, not while it decelerates.
+void wait_at_rest(rccl::Manipulator& arm, nanoseconds timeout) {
+  const auto start = std::chrono::steady_clock::now();
+  (void)arm.waitfor(rccl::Arm::completed(), timeout);
+  const auto left =
+      timeout - std::chrono::duration_cast<nanoseconds>(std::chrono::steady_clock::now() - start);
+  constexpr double kStill = 1e-3;  // rad/s or m/s
+  (void)arm.session().wait_until(
+      [](const rtc::How& h) {
+        const kin::JointVector v = h.velocity();
+        return std::all_of(v.begin(), v.end(), [](double x) { return std::abs(x) < kStill; });
+      },
+      std::max(left, nanoseconds(0)));
+}
+
 /// ValueError for an event of a motion of another arm than `arm` (named `name`).
 void check_event_of(const EventObject& event, const rccl::Manipulator* arm, const std::string& name,
                     const char* what) {
@@ -398,7 +415,7 @@ RobotObject::RobotObject(const std::string& robot, const std::string& clock,
             Parts* p = parts.get();
             owner->interrupt = [p] {
               p->arm.halt();
-              (void)p->arm.waitfor(rccl::Arm::completed(), std::chrono::seconds(1));
+              wait_at_rest(p->arm, std::chrono::seconds(1));
               (void)p->arm.stop_control();
             };
             owner->keep = std::move(parts);
@@ -447,11 +464,10 @@ CellObject::CellObject(const std::string& path, const std::string& clock, bool c
   cell::Cell* c = cell_.get();
   owner_->interrupt = [c] {
     for (const std::string& n : c->robot_names()) c->robot(n).halt();
-    std::vector<rccl::EventGate> all;
-    for (const std::string& n : c->robot_names()) {
-      all.push_back(c->event(n, rccl::Arm::completed()));
-    }
-    (void)c->waitfor(all, std::chrono::seconds(1));
+    // Each robot on its own: the cell's waitfor of all their gates returns as soon as one
+    // fails, which the halt makes the first robot's do at once.
+    for (const std::string& n : c->robot_names())
+      wait_at_rest(c->robot(n), std::chrono::seconds(1));
     for (const std::string& n : c->robot_names()) (void)c->robot(n).stop_control();
   };
   owner_->keep = cell_;
