@@ -16,6 +16,17 @@ from . import _rccx
 
 Transform = _rccx.Transform
 
+# The bound classes and factories, here as well as in rccx, so that this module has what its
+# stub (motion.pyi) declares.
+from ._rccx import (Arm, Cell, CellFileError, EquationError, Event, Gate, LogError,  # noqa: E402
+                    Motion, MotionError, Position, Robot, SessionError, Stream, Together, When,
+                    const, hold, joints, stream, t6)
+
+__all__ = ["Arm", "Cell", "CellFileError", "Equation", "EquationError", "Event", "Factor", "Gate",
+           "LogError", "Motion", "MotionError", "Position", "Product", "Robot", "SessionError",
+           "Stream", "Together", "Transform", "When", "const", "hold", "joints", "position",
+           "stream", "t6"]
+
 
 class Factor:
     """One transform of a product, possibly inverted."""

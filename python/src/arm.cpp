@@ -127,7 +127,33 @@ hw::Plant plant_of(const std::string& plant) {
   }
   raise_value_error(fmt::format(
       "plant must be \"automatic\", \"ideal\", \"servo\" or \"mujoco\", got \"{}\"", plant));
-}
+  /// After a halt(): waits (at most `timeout`) until its motions have ended (the halt fails the
+  /// running one as it begins) and then until the arm's measured joints stand still, so that
+  /// control ends with the arm at rest, not while it decelerates.
+  void wait_at_rest(rccl::Manipulator & arm, nanoseconds timeout) {
+    const auto start = std::chrono::steady_clock::now();
+    (void)arm.waitfor(rccl::Arm::completed(), timeout);
+    const auto left =
+        timeout - std::chrono::duration_cast<nanoseconds>(std::chrono::steady_clock::now() - start);
+    constexpr double kStill = 1e-3;  // rad/s or m/s
+    (void)arm.session().wait_until(
+        [](const rtc::How& h) {
+          const kin::JointVector v = h.velocity();
+          return std::all_of(v.begin(), v.end(), [](double x) { return std::abs(x) < kStill; });
+        },
+        std::max(left, nanoseconds(0)));
+  }
+
+  /// ValueError for an event of a motion of another arm than `arm` (named `name`).
+  void check_event_of(const EventObject& event, const rccl::Manipulator* arm,
+                      const std::string& name, const char* what) {
+    if (event.arm != nullptr && event.arm != arm) {
+      raise_value_error(fmt::format(
+          "{}: {} is an event of robot {}'s motion, not of {}'s (motion ids are each robot's "
+          "own): ask {}, or wait for several robots with cell.waitfor(cell.event(robot, event))",
+          what, event.repr(), event.robot, name, event.robot));
+    }
+  }
 
 }  // namespace
 
@@ -264,9 +290,21 @@ void ArmObject::set_compliance(const std::vector<py::object>& axes,
   locked([&] { arm_->set_compliance(c); });
 }
 
+void ArmObject::check_mine(const EventObject& event, const char* what) const {
+  check_event_of(event, arm_, name_, what);
+}
+
 rccl::StartWhen ArmObject::start_when(const std::vector<WhenObject>& when) const {
   rccl::StartWhen w;
   for (const WhenObject& o : when) {
+    // The gates point into their cell's motion ledgers: another cell's (or a cell's for a
+    // robot of its own) would be read after that cell is gone, and never open meanwhile.
+    if (o.owner != owner_) {
+      raise_value_error(fmt::format(
+          "after: an event of another cell: robot {}'s motion may wait only for robots of its "
+          "own cell",
+          name_));
+    }
     w.after.insert(w.after.end(), o.when.after.begin(), o.when.after.end());
     w.touch |= o.when.touch;
     if (o.when.together) {
@@ -282,12 +320,12 @@ MotionObject ArmObject::move(const rccl::PositionPtr& position,
                              const std::vector<WhenObject>& when) {
   if (!position) raise_value_error("move: no position given");
   const rccl::StartWhen w = start_when(when);
-  return {locked([&] { return arm_->move(position, w); })};
+  return {locked([&] { return arm_->move(position, w); }), arm_, name_};
 }
 
 MotionObject ArmObject::dwell(double seconds, const std::vector<WhenObject>& when) {
   const rccl::StartWhen w = start_when(when);
-  return {locked([&] { return arm_->dwell(seconds, w); })};
+  return {locked([&] { return arm_->dwell(seconds, w); }), arm_, name_};
 }
 
 void ArmObject::halt() {
@@ -309,6 +347,7 @@ EventObject ArmObject::ended(const rccl::PositionPtr& p) const {
 }
 
 std::string ArmObject::waitfor(const EventObject& event, std::optional<double> timeout_s) {
+  check_mine(event, "waitfor");
   check_open();
   rccl::WaitResult r = rccl::WaitResult::timeout;
   sliced_wait(*owner_, timeout_s, arm_->session().period(), [&](nanoseconds d) {
@@ -332,6 +371,7 @@ std::optional<std::string> ArmObject::wait_for(double seconds) {
 }
 
 bool ArmObject::happened(const EventObject& event) {
+  check_mine(event, "happened");
   return locked([&] { return arm_->happened(event.event); });
 }
 
@@ -342,6 +382,7 @@ std::vector<rccl::MotionEvent> ArmObject::take_events() {
   return locked([&] { return arm_->take_events(); });
 }
 rccl::SegmentReport ArmObject::report(const MotionObject& m) {
+  check_mine(m.end(), "report");
   return locked([&] { return arm_->report(m.motion); });
 }
 std::uint64_t ArmObject::last_queued() {
@@ -359,6 +400,9 @@ double ArmObject::time_s() const {
 OutArray ArmObject::joints() const {
   return to_array(arm_->session().how().q().span());
 }
+bool ArmObject::hand_closed() const {
+  return arm_->session().how().hand_closed;
+}
 std::string ArmObject::repr() const {
   return fmt::format("<rccx robot {} ({}), {}>", name_, arm_->kinematics().model().name,
                      owner_->closed ? "closed" : (controlling() ? "in control" : "not in control"));
@@ -371,11 +415,13 @@ void ArmObject::set_tool_load(double mass_kg, const std::optional<InArray>& com_
 }
 
 std::optional<rccl::Contact> ArmObject::contact(const MotionObject& m) {
+  check_mine(m.end(), "contact");
   return locked([&] { return arm_->contact(m.motion); });
 }
 
 void ArmObject::update_from_contact(const MotionObject& m, const rccl::TransformPtr& x,
                                     const rccl::PositionPtr& position) {
+  check_mine(m.end(), "update_from_contact");
   locked([&] { arm_->update_from_contact(m.motion, x, position); });
 }
 
@@ -383,10 +429,6 @@ std::optional<OutArray> ArmObject::wrench() const {
   const rtc::How h = arm_->session().how();
   if (!h.force.present) return std::nullopt;
   return wrench_out(h.force.wrench);
-}
-
-bool ArmObject::hand_closed() const {
-  return arm_->session().how().hand_closed;
 }
 
 // --- RobotObject -----------------------------------------------------------------------------
@@ -405,7 +447,14 @@ RobotObject::RobotObject(kin::RobotModel robot, const std::string& clock,
           [&] {
             rtc::SimulatedRobotOptions o;
             o.clock = clock_of(clock);
-            if (period_s) o.period = seconds_to_ns(*period_s, "period");
+            if (period_s) {
+              // 0 would silently mean the robot's usual period (SessionOptions' default).
+              if (!(*period_s > 0.0)) {
+                raise_value_error(fmt::format(
+                    "period must be > 0 s (None: the robot's usual one), got {}", *period_s));
+              }
+              o.period = seconds_to_ns(*period_s, "period");
+            }
             if (log) o.log = *log;
             kin::RobotModel model = std::move(robot);
             o.plant = plant_of(plant);
@@ -447,7 +496,7 @@ RobotObject::RobotObject(kin::RobotModel robot, const std::string& clock,
             Parts* p = parts.get();
             owner->interrupt = [p] {
               p->arm.halt();
-              (void)p->arm.waitfor(rccl::Arm::completed(), std::chrono::seconds(1));
+              wait_at_rest(p->arm, std::chrono::seconds(1));
               (void)p->arm.stop_control();
             };
             owner->keep = std::move(parts);
@@ -496,11 +545,10 @@ CellObject::CellObject(const std::string& path, const std::string& clock, bool c
   cell::Cell* c = cell_.get();
   owner_->interrupt = [c] {
     for (const std::string& n : c->robot_names()) c->robot(n).halt();
-    std::vector<rccl::EventGate> all;
-    for (const std::string& n : c->robot_names()) {
-      all.push_back(c->event(n, rccl::Arm::completed()));
-    }
-    (void)c->waitfor(all, std::chrono::seconds(1));
+    // Each robot on its own: the cell's waitfor of all their gates returns as soon as one
+    // fails, which the halt makes the first robot's do at once.
+    for (const std::string& n : c->robot_names())
+      wait_at_rest(c->robot(n), std::chrono::seconds(1));
     for (const std::string& n : c->robot_names()) (void)c->robot(n).stop_control();
   };
   owner_->keep = cell_;
@@ -524,11 +572,19 @@ std::vector<std::string> CellObject::robot_names() const {
   return cell_->robot_names();
 }
 
+void CellObject::check_robot(const std::string& robot, const EventObject& event, const char* what) {
+  // cell_->robot names the cell's robots for an unknown name.
+  const rccl::Manipulator* m = locked([&] { return &cell_->robot(robot); });
+  check_event_of(event, m, robot, what);
+}
+
 GateObject CellObject::event(const std::string& robot, const EventObject& event) {
+  check_robot(robot, event, "cell.event");
   return {locked([&] { return cell_->event(robot, event.event); }), owner_};
 }
 
 WhenObject CellObject::after(const std::string& robot, const EventObject& event) {
+  check_robot(robot, event, "cell.after");
   return {locked([&] { return cell_->after(robot, event.event); }), owner_};
 }
 

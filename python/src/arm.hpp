@@ -47,13 +47,19 @@ struct Owner {
 struct EventObject {
   rccl::Event event;
   rccl::PositionPtr position;
+  /// A motion's start or end: the arm whose motion it is (motion ids are an arm's own), so
+  /// that another arm's wait refuses it; null for completed() and ended(p).
+  const rccl::Manipulator* arm = nullptr;
+  std::string robot{};
   [[nodiscard]] std::string repr() const;
 };
 
 struct MotionObject {
   rccl::Motion motion;
-  [[nodiscard]] EventObject start() const { return {motion.start(), nullptr}; }
-  [[nodiscard]] EventObject end() const { return {motion.end(), nullptr}; }
+  const rccl::Manipulator* arm = nullptr;  ///< the arm that queued it
+  std::string robot{};
+  [[nodiscard]] EventObject start() const { return {motion.start(), nullptr, arm, robot}; }
+  [[nodiscard]] EventObject end() const { return {motion.end(), nullptr, arm, robot}; }
 };
 
 /// What a queued motion waits for (rccl::StartWhen): other robots' events, a joint start, the
@@ -103,6 +109,8 @@ class ArmObject {
   /// The last sample read: its time (s since the session opened) and measured joints.
   [[nodiscard]] double time_s() const;
   [[nodiscard]] OutArray joints() const;
+  /// The hand as the last sample read it (How::hand_closed): set_hand's effect, a sample on.
+  [[nodiscard]] bool hand_closed() const;
   [[nodiscard]] const std::string& name() const noexcept { return name_; }
   [[nodiscard]] std::string repr() const;
   /// For rccx.view (view.cpp): what keeps the arm alive, and the arm.
@@ -122,8 +130,6 @@ class ArmObject {
   /// The last sample's sensor reading (6,), N and N m about T6 in T6's axes; None without a
   /// sensor.
   [[nodiscard]] std::optional<OutArray> wrench() const;
-  /// The hand as the last sample read reports it (closed: True).
-  [[nodiscard]] bool hand_closed() const;
 
   /// Runs `step(slice)` (the GIL released, the planning lock taken) until it returns true or
   /// `timeout` has passed (false); between slices checks for signals (Ctrl-C: interrupts the
@@ -144,6 +150,8 @@ class ArmObject {
  protected:
   void check_open() const;
   rccl::StartWhen start_when(const std::vector<WhenObject>& when) const;
+  /// ValueError for an event of another arm's motion (`what`: the call).
+  void check_mine(const EventObject& event, const char* what) const;
 
   std::shared_ptr<Owner> owner_;
   rccl::Manipulator* arm_;
@@ -191,6 +199,8 @@ class CellObject {
   void start();
   ArmObject robot(const std::string& name);
   [[nodiscard]] std::vector<std::string> robot_names() const;
+  /// ValueError for an event of another robot's motion than `robot`'s.
+  void check_robot(const std::string& robot, const EventObject& event, const char* what);
   GateObject event(const std::string& robot, const EventObject& event);
   WhenObject after(const std::string& robot, const EventObject& event);
   WhenObject touching(const std::vector<std::string>& objects);

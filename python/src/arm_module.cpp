@@ -386,10 +386,20 @@ void bind_rccl(py::module_& m) {
           "waitfor",
           [](CellObject& c, const py::object& gates, std::optional<double> timeout) {
             std::vector<GateObject> g;
-            if (py::isinstance<GateObject>(gates)) {
-              g.push_back(gates.cast<GateObject>());
+            const auto one = [&](const py::handle& h) {
+              if (!py::isinstance<GateObject>(h)) {
+                // An Event is a robot's own: the cell needs to know whose (cell.event).
+                throw py::type_error(
+                    "cell.waitfor: give a cell's events, cell.event(robot, event), or a list of "
+                    "them; got " +
+                    py::repr(h).cast<std::string>());
+              }
+              g.push_back(h.cast<GateObject>());
+            };
+            if (py::isinstance<py::list>(gates) || py::isinstance<py::tuple>(gates)) {
+              for (const py::handle h : gates) one(h);
             } else {
-              g = gates.cast<std::vector<GateObject>>();
+              one(gates);
             }
             return c.waitfor(g, timeout);
           },
