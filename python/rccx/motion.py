@@ -20,12 +20,12 @@ Transform = _rccx.Transform
 # stub (motion.pyi) declares.
 from ._rccx import (Arm, Cell, CellFileError, EquationError, Event, Gate, LogError,  # noqa: E402
                     Motion, MotionError, Position, Robot, SessionError, Stream, Together, When,
-                    const, hold, joints, stream, t6)
+                    const, external_wrench, hold, joints, stream, t6, wrench_at_tool)
 
 __all__ = ["Arm", "Cell", "CellFileError", "Equation", "EquationError", "Event", "Factor", "Gate",
            "LogError", "Motion", "MotionError", "Position", "Product", "Robot", "SessionError",
            "Stream", "Together", "Transform", "When", "const", "hold", "joints", "position",
-           "stream", "t6"]
+           "stream", "t6", "external_wrench", "wrench_at_tool"]
 
 
 class Factor:

@@ -127,33 +127,35 @@ hw::Plant plant_of(const std::string& plant) {
   }
   raise_value_error(fmt::format(
       "plant must be \"automatic\", \"ideal\", \"servo\" or \"mujoco\", got \"{}\"", plant));
-  /// After a halt(): waits (at most `timeout`) until its motions have ended (the halt fails the
-  /// running one as it begins) and then until the arm's measured joints stand still, so that
-  /// control ends with the arm at rest, not while it decelerates.
-  void wait_at_rest(rccl::Manipulator & arm, nanoseconds timeout) {
-    const auto start = std::chrono::steady_clock::now();
-    (void)arm.waitfor(rccl::Arm::completed(), timeout);
-    const auto left =
-        timeout - std::chrono::duration_cast<nanoseconds>(std::chrono::steady_clock::now() - start);
-    constexpr double kStill = 1e-3;  // rad/s or m/s
-    (void)arm.session().wait_until(
-        [](const rtc::How& h) {
-          const kin::JointVector v = h.velocity();
-          return std::all_of(v.begin(), v.end(), [](double x) { return std::abs(x) < kStill; });
-        },
-        std::max(left, nanoseconds(0)));
-  }
+}
 
-  /// ValueError for an event of a motion of another arm than `arm` (named `name`).
-  void check_event_of(const EventObject& event, const rccl::Manipulator* arm,
-                      const std::string& name, const char* what) {
-    if (event.arm != nullptr && event.arm != arm) {
-      raise_value_error(fmt::format(
-          "{}: {} is an event of robot {}'s motion, not of {}'s (motion ids are each robot's "
-          "own): ask {}, or wait for several robots with cell.waitfor(cell.event(robot, event))",
-          what, event.repr(), event.robot, name, event.robot));
-    }
+/// After a halt(): waits (at most `timeout`) until its motions have ended (the halt fails the
+/// running one as it begins) and then until the arm's measured joints stand still, so that
+/// control ends with the arm at rest, not while it decelerates.
+void wait_at_rest(rccl::Manipulator& arm, nanoseconds timeout) {
+  const auto start = std::chrono::steady_clock::now();
+  (void)arm.waitfor(rccl::Arm::completed(), timeout);
+  const auto left =
+      timeout - std::chrono::duration_cast<nanoseconds>(std::chrono::steady_clock::now() - start);
+  constexpr double kStill = 1e-3;  // rad/s or m/s
+  (void)arm.session().wait_until(
+      [](const rtc::How& h) {
+        const kin::JointVector v = h.velocity();
+        return std::all_of(v.begin(), v.end(), [](double x) { return std::abs(x) < kStill; });
+      },
+      std::max(left, nanoseconds(0)));
+}
+
+/// ValueError for an event of a motion of another arm than `arm` (named `name`).
+void check_event_of(const EventObject& event, const rccl::Manipulator* arm, const std::string& name,
+                    const char* what) {
+  if (event.arm != nullptr && event.arm != arm) {
+    raise_value_error(fmt::format(
+        "{}: {} is an event of robot {}'s motion, not of {}'s (motion ids are each robot's "
+        "own): ask {}, or wait for several robots with cell.waitfor(cell.event(robot, event))",
+        what, event.repr(), event.robot, name, event.robot));
   }
+}
 
 }  // namespace
 
