@@ -66,10 +66,10 @@ Raises rccx.UnreachableError when there is none, with rccx's reason.)";
 PYBIND11_MODULE(_rccx, m) {
   m.doc() = "rccx's compiled core; import rccx (python/rccx) instead.";
 
-  add_exception<rccx::python::UnreachableError>(
+  rccx::python::add_exception<rccx::python::UnreachableError>(
       m, "UnreachableError", PyExc_ValueError,
       "No joint values within limits put the robot at the pose; the message says why.");
-  add_exception<rccx::kin::RobotFileError>(
+  rccx::python::add_exception<rccx::kin::RobotFileError>(
       m, "RobotFileError", PyExc_ValueError,
       "A robot file or URDF that cannot be used; the message names the file, joint and key.");
 

