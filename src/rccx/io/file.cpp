@@ -66,7 +66,12 @@ AtomicFile::AtomicFile(std::filesystem::path target) : target_(std::move(target)
   destination_ = followed(target_);
   const std::filesystem::path dir =
       destination_.has_parent_path() ? destination_.parent_path() : std::filesystem::path(".");
-  std::string pattern = (dir / ("." + destination_.filename().string() + ".tmp-XXXXXX")).string();
+  // Appended piece by piece: GCC 12 at -O2 takes `"." + name + ...` for an overlapping memcpy
+  // (a false -Wrestrict).
+  std::string hidden = ".";
+  hidden += destination_.filename().string();
+  hidden += ".tmp-XXXXXX";
+  std::string pattern = (dir / hidden).string();
   fd_ = ::mkstemp(pattern.data());
   if (fd_ < 0) {
     throw FileError(fmt::format("cannot write {}: {} (cannot create a file in {})",
