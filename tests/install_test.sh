@@ -13,6 +13,8 @@
 # on PATH for the pkg-config lines (the instrumented libraries need them).
 # Usage: install_test.sh BUILD_DIR SOURCE_DIR "SANITIZER FLAGS (may be empty)"
 set -euo pipefail
+# shellcheck source=tests/readme_block.sh
+source "$(dirname "$0")/readme_block.sh"
 build=$1 source=$2 flags=${3:-}
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
@@ -23,11 +25,7 @@ unset RCCX_DATA_DIR RCCX_CELL RCCX_ROBOT RCCX_LOG RCCX_DB
 # The fenced block after "<!-- install_test: NAME -->" in the README, the prefix and build mapped.
 block() {
   local text
-  text=$(awk -v marker="<!-- install_test: $1 -->" '
-    $0 == marker { found = 1; next }
-    found && /^```/ { if (inside) exit; inside = 1; next }
-    inside { print }' "$readme")
-  [[ -n $text ]] || { echo "README.md has no block marked <!-- install_test: $1 -->" >&2; exit 1; }
+  text=$(readme_block "$readme" "$1") || exit 1
   sed -e "s|/opt/rccx|$prefix|g" -e "s|build/release|$build|g" <<< "$text"
 }
 # Runs PROGRAM (in the current directory), shows its last lines, and requires REGEX in its output.

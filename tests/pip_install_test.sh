@@ -13,6 +13,8 @@
 # ("rccx-skip:"). The pip builds are Release builds of the module's target only, -j2, ccache.
 # Usage: pip_install_test.sh BUILD_DIR SOURCE_DIR RCCX_CLI "LD_PRELOAD for the build's module"
 set -euo pipefail
+# shellcheck source=tests/readme_block.sh
+source "$(dirname "$0")/readme_block.sh"
 build=$1 source=$2 cli=$3 preload=${4:-}
 python=/usr/bin/python3
 work=$(mktemp -d)
@@ -36,11 +38,7 @@ done
 # The fenced block after "<!-- install_test: NAME -->" in the README, ~/venvs mapped.
 block() {
   local text
-  text=$(awk -v marker="<!-- install_test: $1 -->" '
-    $0 == marker { found = 1; next }
-    found && /^```/ { if (inside) exit; inside = 1; next }
-    inside { print }' "$readme")
-  [[ -n $text ]] || { echo "README.md has no block marked <!-- install_test: $1 -->" >&2; exit 1; }
+  text=$(readme_block "$readme" "$1") || exit 1
   echo "${text//\~\/venvs/$work/venvs}"
 }
 # Runs the block NAME in the clean copy; its output in $work/NAME.log, shown when it fails.

@@ -63,3 +63,16 @@ def random_joints(k, count, seed):
     lo = np.where(np.isfinite(k.lower), k.lower, -np.pi)
     hi = np.where(np.isfinite(k.upper), k.upper, np.pi)
     return lo + (hi - lo) * rng.random((count, k.dof))
+
+
+def random_transform(rng, reach_m=1.0):
+    """A random rigid transform (4, 4): an orthonormal, right-handed rotation (QR of a random
+    matrix), a position within `reach_m` (m) of the origin along each axis."""
+    q, r = np.linalg.qr(rng.normal(size=(3, 3)))
+    q = q * np.sign(np.diag(r))
+    if np.linalg.det(q) < 0:
+        q[:, 0] = -q[:, 0]
+    T = np.eye(4)
+    T[:3, :3] = q
+    T[:3, 3] = rng.uniform(-reach_m, reach_m, 3)
+    return T

@@ -11,7 +11,7 @@ import time
 import numpy as np
 import pytest
 
-from _support import cli, import_rccx, numbers
+from _support import cli, import_rccx, numbers, random_transform
 
 rccx = import_rccx()
 
@@ -21,19 +21,6 @@ def rot_z(angle, p):
     T = np.eye(4)
     T[:2, :2] = [[c, -s], [s, c]]
     T[:3, 3] = p
-    return T
-
-
-def random_transform(rng):
-    """A rigid transform: an orthonormal, right-handed rotation (QR of a random matrix), a
-    position within 1 m."""
-    q, r = np.linalg.qr(rng.normal(size=(3, 3)))
-    q = q * np.sign(np.diag(r))
-    if np.linalg.det(q) < 0:
-        q[:, 0] = -q[:, 0]
-    T = np.eye(4)
-    T[:3, :3] = q
-    T[:3, 3] = rng.uniform(-1, 1, 3)
     return T
 
 

@@ -5,22 +5,14 @@ equations raising rccx.EquationError with rccx's message."""
 import numpy as np
 import pytest
 
-from _support import import_rccx
+from _support import import_rccx, random_transform
 
 rccx = import_rccx()
 
 
 def rigid(seed):
     """A random rigid transform (4, 4), m."""
-    rng = np.random.default_rng(seed)
-    q, r = np.linalg.qr(rng.normal(size=(3, 3)))
-    q = q @ np.diag(np.sign(np.diag(r)))
-    if np.linalg.det(q) < 0:
-        q[:, 0] = -q[:, 0]
-    T = np.eye(4)
-    T[:3, :3] = q
-    T[:3, 3] = rng.uniform(-0.5, 0.5, 3)
-    return T
+    return random_transform(np.random.default_rng(seed), reach_m=0.5)
 
 
 inv = np.linalg.inv
