@@ -1,3 +1,4 @@
+# shellcheck shell=bash
 # Sourced by the install tests: readme_block FILE NAME prints the fenced block that follows the
 # line "<!-- install_test: NAME -->" in FILE (the README), as written; exits 1 saying so when
 # there is none.
