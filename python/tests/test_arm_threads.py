@@ -13,7 +13,7 @@ import time
 import numpy as np
 import pytest
 
-from _support import import_rccx
+from _support import import_rccx, skip_if_control_ended
 
 rccx = import_rccx()
 
@@ -89,7 +89,8 @@ def test_other_thread_keeps_its_progress_while_waiting():
             busy = statistics.median(busy_pairs)
             if waited >= 0.95:
                 break
-        assert not arm.happened(arm.completed()) and arm.controlling
+        skip_if_control_ended(arm)
+        assert not arm.happened(arm.completed())
         print(f"progress kept while waiting: {waited:.3f}, while a Python loop holds the GIL: "
               f"{busy:.3f} ({len(waited_pairs)} windows of {WINDOW_S} s each)")
         assert waited >= 0.95, waited_pairs
@@ -110,7 +111,9 @@ def test_ctrl_c_in_a_wait_ends_control(clock):
         arm.set_velocity(0.01, 0.05)  # slow: the motion takes many seconds
         arm.move(rccx.joints("FAR", k.ready + np.array([0.5, -0.3, 0.3, 0.5, 0.5, 0.5])))
         arm.dwell(1000.0)
-        assert arm.waitfor(arm.completed(), timeout=0.2) == "timeout"
+        if arm.waitfor(arm.completed(), timeout=0.2) == "session_ended":
+            skip_if_control_ended(arm)  # before the Ctrl-C: the load ended it
+        assert arm.controlling
         q_moving = arm.q.copy()
         timer = interrupt_after(0.3)
         start = time.perf_counter()
@@ -206,7 +209,7 @@ def test_threads_share_a_robot():
     # One thread waits for motions while another queues them and reads reports, and the main
     # thread closes the robot under a third's wait: every call is serialised by the planning
     # lock; the late wait raises SessionError, nothing crashes.
-    with rccx.Robot("puma560", clock="real_time", period=0.02) as arm:
+    with rccx.Robot("puma560", clock="real_time", period=0.05) as arm:
         k = arm.kinematics
         errors, results = [], []
         queued = threading.Event()
@@ -238,10 +241,10 @@ def test_threads_share_a_robot():
             t.join(60)
         assert not errors, errors
         waits = [r for r in results if isinstance(r, str)]
-        if waits == ["session_ended"] and not arm.controlling:
-            # RTC ended control: a sample overran its period (a loaded machine, a sanitized
-            # build); the machine's real time was judged, not the threads' sharing.
-            pytest.skip(f"real time under load: control ended ({arm.failures()})")
+        if waits == ["session_ended"]:
+            # A sample overran its period (a loaded machine, a sanitized build): the machine's
+            # real time was judged, not the threads' sharing.
+            skip_if_control_ended(arm)
         assert waits == ["reached"], (waits, arm.failures())
         assert [r for r in results if isinstance(r, int)] == [1, 2, 3, 4, 5, 6]
         # close() while another thread waits
