@@ -61,6 +61,25 @@ TEST_F(RandomFrames, RotationAboutAnAxisMatchesEigenAngleAxis) {
   }
 }
 
+TEST_F(RandomFrames, RotatedByIsTheAngularVelocitysFlow) {
+  for (int i = 0; i < 200; ++i) {
+    const Rot3 R = Rot3::about(random_axis(), angle(rng));
+    const Vec3 w = random_axis() * (3.0 * unit(rng));  // rad/s
+    const double dt = 0.5 * unit(rng);                 // s
+    // Its derivative at dt = 0 is [w]x R (finite difference), and it composes in time.
+    const double h = 1e-6;
+    const Eigen::Matrix3d wx =
+        (Eigen::Matrix3d() << 0, -w.z, w.y, w.z, 0, -w.x, -w.y, w.x, 0).finished();
+    const Eigen::Matrix3d derivative =
+        (to_eigen(rotated_by(R, w, h)) - to_eigen(rotated_by(R, w, -h))) / (2 * h);
+    EXPECT_LT((derivative - wx * to_eigen(R)).cwiseAbs().maxCoeff(), 1e-8);
+    EXPECT_LT(max_diff(rotated_by(rotated_by(R, w, dt), w, 0.3), rotated_by(R, w, dt + 0.3)),
+              1e-14);
+  }
+  const Rot3 R = Rot3::about({0, 0, 1}, 0.4);
+  EXPECT_EQ(max_diff(rotated_by(R, {}, 1.0), R), 0.0);  // no rate: unchanged, no NaN
+}
+
 TEST(Rotations, PrincipalAxesAgreeWithAbout) {
   for (double t : {-2.0, -0.3, 0.0, 1.1, 3.0}) {
     EXPECT_LT(max_diff(Rot3::rot_x(t), Rot3::about({1, 0, 0}, t)), 1e-15);

@@ -15,9 +15,12 @@ at every sample (lock-free). How it is fed:
       coming setpoint before each step: deterministic, as a conveyor encoder read each sample;
   --clock real_time: a Python thread reads the clock and puts the pose every --feed-ms, as a
       thread reading a conveyor's encoder would; the goal is then as old as the last put.
-Fed sample by sample with the belt's pose for each setpoint's time, the stream gives the
-generator what the C++ function does, and the program prints the C++'s figures; fed by a thread,
-the goal is as old as the last put (up to --feed-ms) and stands still between puts.
+Each put() says the time the pose is for and the belt's velocity (put(T, at=, velocity=)), so
+the generator moves the pose on to each setpoint's own time: fed sample by sample, the stream
+gives what the C++ function does, and the program prints the C++'s figures; fed less often
+(--put-every) or by a thread that the machine's load holds up, the goal still moves smoothly.
+With --no-velocity the poses are put bare: the goal stands still between puts and then jumps,
+which the generator's acceleration guard refuses once the jump is large (the motion fails).
 
 The arm goes above the belt in joint mode, moves in Cartesian mode onto the moving object,
 rides along for 3 s, then parks. It prints the tracking lag: at every sample of those 3 s, the
@@ -52,6 +55,18 @@ def belt(t_s):
     return translation(0.0, BELT_SPEED_M_PER_S * t_s, 0.0)
 
 
+BELT_VELOCITY = np.array([0.0, BELT_SPEED_M_PER_S, 0.0, 0.0, 0.0, 0.0])  # m/s, rad/s
+
+
+def put_belt(conv, t_s, with_velocity):
+    """Puts the belt's pose at session time t_s, with that time and its velocity (the stream
+    extrapolates it to each setpoint's time) or bare."""
+    if with_velocity:
+        conv.put(belt(t_s), at=t_s, velocity=BELT_VELOCITY)
+    else:
+        conv.put(belt(t_s))
+
+
 def rot_x(a):
     c, s = math.cos(a), math.sin(a)
     return np.array([[1, 0, 0], [0, c, -s], [0, s, c]])
@@ -64,13 +79,16 @@ def rot_y(a):
 
 class SteppedFeed:
     """Simulated time: the program runs the samples one by one, putting the belt's pose for the
-    setpoint each computes (`lead_s` ahead of the last sample read)."""
+    setpoint each computes (`lead_s` ahead of the last sample read) every `every` samples."""
 
-    def __init__(self, arm, conv, lead_s):
+    def __init__(self, arm, conv, lead_s, every, with_velocity):
         self.arm, self.conv, self.lead_s = arm, conv, lead_s
+        self.every, self.with_velocity, self.steps = every, with_velocity, 0
 
     def step(self):
-        self.conv.put(belt(self.arm.time + self.lead_s))
+        if self.steps % self.every == 0:
+            put_belt(self.conv, self.arm.time + self.lead_s, self.with_velocity)
+        self.steps += 1
         return self.arm.wait_for(self.arm.period)
 
     def waitfor(self, event, timeout_s=60.0):
@@ -88,17 +106,20 @@ class ThreadFeed:
     """Real time: a Python thread puts the belt's pose every `feed_s`, from the host's clock
     mapped onto the session's; the program waits as usual."""
 
-    def __init__(self, arm, conv, lead_s, feed_s):
+    def __init__(self, arm, conv, lead_s, feed_s, with_velocity):
         self.arm = arm
         self.offset_s = arm.time - time.monotonic()  # session time - host time, about
         self.stop = threading.Event()
 
+        def put():
+            put_belt(conv, time.monotonic() + self.offset_s + lead_s, with_velocity)
+
         def run():
             while not self.stop.is_set():
-                conv.put(belt(time.monotonic() + self.offset_s + lead_s))
+                put()
                 self.stop.wait(feed_s)
 
-        conv.put(belt(time.monotonic() + self.offset_s + lead_s))
+        put()
         self.thread = threading.Thread(target=run, name="conveyor-feed", daemon=True)
         self.thread.start()
 
@@ -113,6 +134,12 @@ class ThreadFeed:
         self.thread.join()
 
 
+def feeding(args):
+    how = ("by a thread" if args.clock == "real_time" else
+           "sample by sample" if args.put_every == 1 else f"every {args.put_every} samples")
+    return how + (", bare poses" if args.no_velocity else ", poses with their time and velocity")
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--clock", choices=("simulated", "real_time"), default="simulated",
@@ -120,15 +147,23 @@ def main(argv=None):
                     "before each) or real_time (a thread feeds it)")
     ap.add_argument("--feed-ms", type=float, default=5.0,
                     help="real_time: the feeding thread's period, ms (default 5)")
+    ap.add_argument("--put-every", type=int, default=1, metavar="N",
+                    help="simulated: put the belt's pose every N samples (default 1)")
+    ap.add_argument("--no-velocity", action="store_true",
+                    help="put bare poses, without their time and velocity: the goal stands "
+                    "between puts and jumps at each")
     ap.add_argument("--bound-mm", type=float, default=None,
                     help="the largest tracking lag accepted, mm (default: 2, the C++ example's, "
-                    "plus the belt's travel in two feed periods in real time)")
+                    "plus the belt's travel in two feed periods for bare poses in real time)")
     args = ap.parse_args(argv)
     if not 0.5 <= args.feed_ms <= 100.0:
         ap.error("--feed-ms must be within 0.5 .. 100")
+    if not 1 <= args.put_every <= 100:
+        ap.error("--put-every must be within 1 .. 100")
+    # Bare poses fed by a thread are up to a feed period old: the belt's travel in two more.
     bound_m = (args.bound_mm * 1e-3 if args.bound_mm is not None else
                0.002 + (2 * BELT_SPEED_M_PER_S * args.feed_ms * 1e-3
-                        if args.clock == "real_time" else 0.0))
+                        if args.clock == "real_time" and args.no_velocity else 0.0))
 
     T6 = rccx.t6()
     CONV = rccx.stream("CONV", belt(0.0))
@@ -142,15 +177,17 @@ def main(argv=None):
     OVER = rccx.const("OVER", translation(0.450, -0.050, -0.150))
     ABOVE_BELT = rccx.position("ABOVE_BELT", T6 == OVER * GRASP)
     print(f"{ON_BELT.describe()}: belt at {BELT_SPEED_M_PER_S * 1e3:.0f} mm/s along y "
-          f"(a stream fed {'sample by sample' if args.clock == 'simulated' else 'by a thread'})")
+          f"(a stream fed {feeding(args)})")
 
     with rccx.Robot("puma560", clock=args.clock) as arm:  # PID servos, 10 ms samples
         period_s = arm.period
         # The next sample comes one period after the last one read (arm.time), and the setpoint
         # it computes is for two periods after it (the session's pipeline): put the belt there.
         lead_s = 3 * period_s
-        feed = (SteppedFeed(arm, CONV, lead_s) if args.clock == "simulated" else
-                ThreadFeed(arm, CONV, lead_s, args.feed_ms * 1e-3))
+        with_velocity = not args.no_velocity
+        feed = (SteppedFeed(arm, CONV, lead_s, args.put_every, with_velocity)
+                if args.clock == "simulated" else
+                ThreadFeed(arm, CONV, lead_s, args.feed_ms * 1e-3, with_velocity))
         k = arm.kinematics
         try:
             motions = [arm.move(ABOVE_BELT)]  # joint mode

@@ -132,9 +132,15 @@ void bind_rccl(py::module_& m) {
       m, "Stream",
       "A functional transform the program feeds (rccx.stream): put() from any thread; the "
       "sample loop takes the newest pose at each sample (lock-free, no Python).")
-      .def("put", &StreamTransform::put, py::arg("T"),
-           "Publishes a pose (4, 4), m, stamped now; the GIL is released. The loop uses it from "
-           "the next sample that evaluates the stream on.")
+      .def("put", &StreamTransform::put, py::arg("T"), py::kw_only(), py::arg("at") = py::none(),
+           py::arg("velocity") = py::none(),
+           "Publishes a pose T (4, 4), m, stamped now; the GIL is released. The loop uses it "
+           "from the next sample that evaluates the stream on. With at (the session time T is "
+           "for, s, on arm.time's clock) and velocity ((6,): m/s along x, y, z then rad/s about "
+           "them, in the stream's parent frame), each setpoint gets T moved on to its own time, "
+           "at most max_extrapolation either way: a late put() leaves the goal moving smoothly.")
+      .def_property_readonly("max_extrapolation", &StreamTransform::max_extrapolation_s,
+                             "How far, s, a put() with at= and velocity= is extrapolated.")
       .def_property_readonly("newest", &StreamTransform::newest,
                              "The newest pose put (the initial one before any), (4, 4).")
       .def_property_readonly("age", &StreamTransform::age,
@@ -147,9 +153,11 @@ void bind_rccl(py::module_& m) {
   m.def("hold", &make_hold, py::arg("name"), py::arg("T") = py::none(),
         "A hold transform starting at T (4, 4), m (default identity); .set(T) changes it for "
         "the next motion that uses it.");
-  m.def("stream", &make_stream, py::arg("name"), py::arg("T") = py::none(),
+  m.def("stream", &make_stream, py::arg("name"), py::arg("T") = py::none(), py::kw_only(),
+        py::arg("max_extrapolation") = 0.25,
         "A functional transform fed by .put(T) (any thread); its value before the first put is "
-        "T (default identity).");
+        "T (default identity). max_extrapolation: how far, s, a pose put with its time and "
+        "velocity is moved on (default 0.25; 0 to 10): past it a silent feeder's goal stands.");
   m.def("_make_position", &make_position, py::arg("name"), py::arg("lhs"), py::arg("rhs"),
         py::arg("tool") = py::none());
   m.def("joints", &make_joints, py::arg("name"), py::arg("q"),

@@ -57,17 +57,51 @@ std::string transform_repr(const rccl::Transform& t) {
 StreamTransform::StreamTransform(std::string name, std::shared_ptr<State> state)
     : rccl::Transform(std::move(name), rccl::TransformKind::functional, math::Transform::identity(),
                       // The loop's read: the newest sample, lock-free; never Python.
-                      [s = state](const rccl::SampleContext&) {
+                      [s = state](const rccl::SampleContext& ctx) {
                         Sample sample;
-                        return s->latest.load(sample) ? sample.pose : s->initial;
+                        if (!s->latest.load(sample)) return s->initial;
+                        // Planning (no sample read) takes the pose as put, as remote frames do.
+                        if (ctx.how == nullptr || std::isnan(sample.at_s)) return sample.pose;
+                        const double dt = std::clamp(ctx.t_s - sample.at_s, -s->max_extrapolation_s,
+                                                     s->max_extrapolation_s);
+                        math::Transform p = sample.pose;
+                        p.p += sample.velocity_m_per_s * dt;
+                        p.R = math::rotated_by(p.R, sample.angular_velocity_rad_per_s, dt);
+                        return p;
                       }),
       state_(std::move(state)) {}
 
-void StreamTransform::put(const InArray& T) {
-  const math::Transform pose = transform_in(T, name() + ".put");
+void StreamTransform::put(const InArray& T, std::optional<double> at_s,
+                          const std::optional<InArray>& velocity) {
+  Sample sample;
+  sample.pose = transform_in(T, name() + ".put");
+  if (at_s) {
+    if (!std::isfinite(*at_s)) {
+      raise_value_error(
+          fmt::format("{}.put: at must be a finite session time, s, got {}", name(), *at_s));
+    }
+    sample.at_s = *at_s;
+  }
+  if (velocity) {
+    if (!at_s) {
+      raise_value_error(fmt::format(
+          "{}.put: a velocity needs at= (the session time the pose is for, s, e.g. arm.time)",
+          name()));
+    }
+    if (ndim(*velocity) != 1 || extent(*velocity, 0) != 6 || !all_finite(velocity->data(), 6)) {
+      raise_value_error(fmt::format(
+          "{}.put: velocity must be 6 finite values (m/s, m/s, m/s, rad/s, rad/s, rad/s), got "
+          "shape {}",
+          name(), shape_text(*velocity)));
+    }
+    const double* v = velocity->data();
+    sample.velocity_m_per_s = {v[0], v[1], v[2]};
+    sample.angular_velocity_rad_per_s = {v[3], v[4], v[5]};
+  }
   const ReleaseGil release;  // another writer may hold the lock a moment
   const std::lock_guard lock(state_->writers);
-  state_->latest.store({pose, steady_ns()});
+  sample.stamp_ns = steady_ns();
+  state_->latest.store(sample);
   ++state_->count;
 }
 
@@ -88,9 +122,15 @@ std::uint64_t StreamTransform::count() const {
 }
 
 std::shared_ptr<StreamTransform> make_stream(const std::string& name,
-                                             const std::optional<InArray>& T) {
+                                             const std::optional<InArray>& T,
+                                             double max_extrapolation_s) {
+  if (!(max_extrapolation_s >= 0.0 && max_extrapolation_s <= 10.0)) {
+    raise_value_error(fmt::format("stream {}: max_extrapolation must be within 0 .. 10 s, got {}",
+                                  name, max_extrapolation_s));
+  }
   auto state = std::make_shared<StreamTransform::State>();
   state->initial = T ? transform_in(*T, "stream " + name) : math::Transform::identity();
+  state->max_extrapolation_s = max_extrapolation_s;
   return std::make_shared<StreamTransform>(name, std::move(state));
 }
 

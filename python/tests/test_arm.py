@@ -63,6 +63,36 @@ def test_stream_goal_reached():
         np.testing.assert_allclose(k.forward(arm.q), goal, atol=2e-3)
 
 
+def test_stream_with_time_and_velocity_moves_the_goal_on():
+    # One put(), with the session time the pose is for and its velocity: the arm follows the
+    # goal the stream extrapolates at each setpoint, measured (forward kinematics of arm.q),
+    # until max_extrapolation past the put's time, where the goal stands.
+    v_m_per_s, max_s = 0.02, 1.5
+    with rccx.Robot("puma560") as arm:
+        k = arm.kinematics
+        start = k.forward(k.ready)
+        s = rccx.stream("TARGET", start, max_extrapolation=max_s)
+        assert s.max_extrapolation == max_s
+        at_s = arm.time
+        s.put(start, at=at_s, velocity=[0.0, v_m_per_s, 0.0, 0.0, 0.0, 0.0])
+        arm.set_mode("cartesian")
+        m = arm.move(rccx.position("FOLLOW", rccx.t6() == s))
+        assert arm.waitfor(m.end, timeout=30) == "reached"
+        lags_m = []
+        while arm.time < at_s + max_s - 0.1:
+            arm.wait_for(0.1)
+            y_goal = start[1, 3] + v_m_per_s * (arm.time - at_s)
+            lags_m.append(abs(k.forward(arm.q)[1, 3] - y_goal))
+        assert len(lags_m) >= 5 and max(lags_m) < 2e-3, lags_m  # moving: about 3 samples behind
+        arm.wait_for(0.5)
+        here = k.forward(arm.q)
+        np.testing.assert_allclose(here[:3, 3], start[:3, 3] + [0.0, v_m_per_s * max_s, 0.0],
+                                   atol=5e-4)
+        arm.wait_for(0.2)
+        # The goal stands: the wrist stays (its orientation still settles, about 1e-4 rad).
+        np.testing.assert_allclose(k.forward(arm.q)[:3, 3], here[:3, 3], atol=1e-5)
+
+
 def test_motion_events_and_report():
     with rccx.Robot("puma560") as arm:
         k = arm.kinematics

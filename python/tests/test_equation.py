@@ -73,6 +73,28 @@ def test_stream_newest_and_age():
         p.t6()
 
 
+def test_stream_put_with_time_and_velocity_and_its_errors():
+    s = rccx.stream("S", rigid(10))
+    assert s.max_extrapolation == 0.25
+    s.put(rigid(11), at=2.0, velocity=np.arange(6.0))
+    # Outside a sample (planning) the value is the pose as put.
+    np.testing.assert_array_equal(s.value, rigid(11))
+    assert s.count == 1
+    bad = [({"velocity": np.zeros(6)}, "needs at="),
+           ({"at": float("nan")}, "finite"),
+           ({"at": 1.0, "velocity": np.zeros(3)}, "6 finite values"),
+           ({"at": 1.0, "velocity": [0, 0, float("inf"), 0, 0, 0]}, "6 finite values")]
+    for kwargs, message in bad:
+        with pytest.raises(ValueError, match=message):
+            s.put(rigid(12), **kwargs)
+    # A refused put changes nothing.
+    assert s.count == 1
+    np.testing.assert_array_equal(s.newest, rigid(11))
+    for bad_s in (-0.1, float("nan"), 11.0):
+        with pytest.raises(ValueError, match="max_extrapolation"):
+            rccx.stream("S", max_extrapolation=bad_s)
+
+
 def test_transforms_in_lists_keep_identity():
     a, b = rccx.const("A", np.eye(4)), rccx.const("B", np.eye(4))
     assert a in [a] and b not in [a] and a != b

@@ -30,13 +30,6 @@ rtc::SessionOptions group_options(const CellModel& m, const CellOptions& o) {
   return so;
 }
 
-/// R(dt) from angular velocity w (world frame) applied to R.
-math::Rot3 rotate(const math::Rot3& R, const math::Vec3& w, double dt) noexcept {
-  const double rate = w.norm();
-  if (!(rate * std::abs(dt) > 1e-12)) return R;
-  return math::Rot3::about(w * (1.0 / rate), rate * dt) * R;
-}
-
 }  // namespace
 
 double Cell::braking_m(const kin::RobotModel& model, const kin::JointVector& q0,
@@ -508,7 +501,7 @@ rccl::TransformPtr Cell::tool_frame(std::string_view leader) const {
     math::Transform p = s.pose;
     p.p = p.p + s.velocity_m_per_s * dt +
           s.acceleration_m_per_s2 * (accelerating * accelerating / 2.0);
-    p.R = rotate(p.R, s.angular_velocity_rad_s, dt);
+    p.R = math::rotated_by(p.R, s.angular_velocity_rad_s, dt);
     return p;
   });
   t->set_reference("frame:" + r->name);  // a serve process resolves it by the robot's name

@@ -112,6 +112,12 @@ double max_abs_difference(const Transform& a, const Transform& b) noexcept {
   return m;
 }
 
+Rot3 rotated_by(const Rot3& R, const Vec3& w_rad_per_s, double dt_s) noexcept {
+  const double rate = w_rad_per_s.norm();
+  if (!(rate * std::abs(dt_s) > 1e-12)) return R;
+  return Rot3::about(w_rad_per_s * (1.0 / rate), rate * dt_s) * R;
+}
+
 DriveTransform::DriveTransform(const Transform& from, const Transform& to) noexcept
     : from_(from), to_(to) {
   const Transform rel = from.inverse_times(to);

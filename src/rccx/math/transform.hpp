@@ -161,6 +161,10 @@ struct Transform {
 /// Largest absolute difference between corresponding elements of the top three rows.
 double max_abs_difference(const Transform& a, const Transform& b) noexcept;
 
+/// R turned for dt_s at the constant angular velocity w_rad_per_s (in R's parent frame):
+/// exp([w] dt) R, what extrapolating a moving frame's orientation needs.
+Rot3 rotated_by(const Rot3& R, const Vec3& w_rad_per_s, double dt_s) noexcept;
+
 /// Paul's drive transform (Robot Manipulators, 1981, ch. 5): the motion from frame A to frame B
 /// split into a translation, a rotation about an axis perpendicular to A's approach vector that
 /// swings it onto B's, and a rotation about the approach vector, each scaled by the fraction r.

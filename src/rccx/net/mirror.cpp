@@ -9,16 +9,6 @@
 
 namespace rccx::net {
 
-namespace {
-
-math::Rot3 rotate(const math::Rot3& R, const math::Vec3& w, double dt) noexcept {
-  const double rate = w.norm();
-  if (!(rate * std::abs(dt) > 1e-12)) return R;
-  return math::Rot3::about(w * (1.0 / rate), rate * dt) * R;
-}
-
-}  // namespace
-
 std::int64_t steady_ns() noexcept {
   timespec ts{};
   clock_gettime(CLOCK_MONOTONIC, &ts);
@@ -40,7 +30,7 @@ rccl::TransformPtr remote_frame(std::string name, std::string reference,
     const double dt = std::clamp(static_cast<double>(target - s.stamp_ns) * 1e-9, -0.25, max_dt);
     math::Transform p = s.pose;
     p.p = p.p + s.velocity_m_per_s * dt + s.acceleration_m_per_s2 * (dt * dt / 2.0);
-    p.R = rotate(p.R, s.angular_velocity_rad_s, dt);
+    p.R = math::rotated_by(p.R, s.angular_velocity_rad_s, dt);
     return p;
   });
   t->set_reference(std::move(reference));
