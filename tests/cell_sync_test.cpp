@@ -295,7 +295,22 @@ TEST(CellSync, BadStartConditionsAreRefusedAtTheCall) {
   EXPECT_THROW((void)c->event("puma", rccl::Manipulator::ended(p)), rccl::MotionError);
   EXPECT_THROW((void)c->event("scara", rccl::Manipulator::completed()), std::invalid_argument);
   EXPECT_THROW((void)c->together({"puma", "puma"}), std::invalid_argument);
+  // The Microbo's place in a joint start given to the PUMA's motion.
+  const cell::Together go = c->together({"puma", "microbo"});
+  try {
+    (void)puma.move(puma.park(), go.when("microbo"));
+    ADD_FAILURE() << "another robot's place in a joint start was taken";
+  } catch (const rccl::MotionError& e) {
+    EXPECT_NE(std::string(e.what()).find("place 1 is robot microbo's"), std::string::npos)
+        << e.what();
+  }
   EXPECT_TRUE(puma.happened(rccl::Manipulator::completed())) << "nothing was queued";
+  // Its own place is taken: the arm stays at rest, waiting for the Microbo's part.
+  const math::Vec3 at0 = tool_point(*c, "puma", c->session("puma").how().q());
+  (void)puma.move(world_position(*c, "puma", "O", down_at(kPumaAt + kDy)), go.when("puma"));
+  c->wait_for(300ms);
+  // (its servo settles by some 0.05 mm; started, the 30 mm motion would be far on)
+  EXPECT_LT((tool_point(*c, "puma", c->session("puma").how().q()) - at0).norm(), 5e-4);
 }
 
 TEST(CellSync, AChainedStartIsTheNextSampleWhicheverRobotIsSteppedFirst) {

@@ -334,6 +334,12 @@ def test_together_starts_in_the_same_sample(end_together):
         assert microbo.report(alone)["start"] < puma.report(busy)["end"] - 0.1
         with pytest.raises(ValueError, match="microbo"):
             cell.together(["puma", "nobody"])
+        # Another robot's place in a joint start is refused; nothing is queued.
+        tg = cell.together(["puma", "microbo"])
+        before = puma.last_queued
+        with pytest.raises(rccx.MotionError, match="place 1 is robot microbo's"):
+            puma.move(rccx.joints("P4", kp.ready), after=tg.when("microbo"))
+        assert puma.last_queued == before
 
 
 def _down(x, y, z):

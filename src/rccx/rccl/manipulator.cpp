@@ -305,6 +305,14 @@ Motion Manipulator::submit(MotionRequest r, const PositionPtr& keep, const Start
       throw MotionError(fmt::format("rendezvous slot {} of {} participants", when.slot,
                                     when.together->participants()));
     }
+    // Another robot's place would start this one with the wrong partner and leave its own
+    // place empty: the joint start would never come.
+    const MotionLedger* holder = when.together->participant(when.slot);
+    if (holder != nullptr && holder->robot() != generator_->ledger().robot()) {
+      throw MotionError(fmt::format(
+          "this joint start's place {} is robot {}'s: give robot {}'s motion together.when(\"{}\")",
+          when.slot, holder->robot(), generator_->ledger().robot(), generator_->ledger().robot()));
+    }
     if (when.together->start_s() >= 0.0 || !when.together->withdrawn().empty()) {
       throw MotionError("this rendezvous has been used (or broken) already: make a new one");
     }

@@ -147,6 +147,10 @@ class Rendezvous {
   [[nodiscard]] const MotionLedger* lost_participant() const noexcept;
   /// The participant `ledger` stands for, or participants() when it is none of them.
   [[nodiscard]] std::size_t slot_of(const MotionLedger* ledger) const noexcept;
+  /// The ledger of the robot that takes place `slot` (nullptr when not known).
+  [[nodiscard]] const MotionLedger* participant(std::size_t slot) const noexcept {
+    return slot < ledgers_.size() ? ledgers_[slot] : nullptr;
+  }
 
  private:
   std::size_t n_;
