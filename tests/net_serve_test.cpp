@@ -422,8 +422,11 @@ TEST(NetServe, ASecondServeOfARobotIsRefusedNamingTheHolder) {
   EXPECT_EQ(first->wait_exit(10ms), -1) << "the first serve stopped";
 }
 
-TEST(NetServe, AKilledServeFailsTheProgramsWaitWithinTheDetectionTime) {
-  const std::uint32_t d = domain();
+/// One attempt of the test below (net_attempts.hpp: a serve's overrun before the kill, which
+/// ends its control at once and leaves nothing of the detection to judge, runs it again on a
+/// domain of its own).
+void killed_serve_once(int attempt, bool& again) {
+  const std::uint32_t d = domain(attempt - 1);
   auto s = serve(d, "puma", "serve_killed");
   net::RemoteOptions ro;
   ro.robots = {"puma"};
@@ -434,7 +437,11 @@ TEST(NetServe, AKilledServeFailsTheProgramsWaitWithinTheDetectionTime) {
   q[0] += 1.0;
   puma.set_velocity(0.05, 0.2);
   const rccl::Motion m = puma.move(rccl::Position::joints("FAR", q));
-  ASSERT_EQ(puma.waitfor(m.start(), 10s), rccl::WaitResult::reached);
+  const rccl::WaitResult started = puma.waitfor(m.start(), 10s);
+  if (started != rccl::WaitResult::reached) {
+    RETRY_OR_SKIP_ON_OVERRUN(failures_text(puma.failures()) + s->err());
+  }
+  ASSERT_EQ(started, rccl::WaitResult::reached) << failures_text(puma.failures());
   std::atomic<std::int64_t> returned{0};
   rccl::WaitResult result = rccl::WaitResult::reached;
   std::thread waiter([&] {
@@ -449,11 +456,12 @@ TEST(NetServe, AKilledServeFailsTheProgramsWaitWithinTheDetectionTime) {
   std::printf(
       "kill -9 of the serve -> the program's waitfor failed after %.1f ms (detection %d ms)\n", ms,
       kDetectionMs);
-  EXPECT_EQ(result, rccl::WaitResult::failed);
-  EXPECT_LT(ms, 3.0 * kDetectionMs) << "detection took too long";
   const auto f = puma.failures();
   ASSERT_FALSE(f.empty());
   const std::string why(f.back().message());
+  if (ms < 0.0) RETRY_OR_SKIP_ON_OVERRUN(why);  // control ended before the kill
+  EXPECT_EQ(result, rccl::WaitResult::failed);
+  EXPECT_LT(ms, 3.0 * kDetectionMs) << "detection took too long";
   EXPECT_TRUE(contains(why, "robot puma lost: its serve process " + holder + " is silent")) << why;
   EXPECT_THROW((void)puma.move(puma.park()), rccl::MotionError);
 
@@ -461,8 +469,8 @@ TEST(NetServe, AKilledServeFailsTheProgramsWaitWithinTheDetectionTime) {
   // build may overrun its 7 ms period now and then (docs/NETWORK.md, the demonstration across
   // processes), which ends its control: then once more with another serve, and said.
   std::string before = holder;
-  for (int attempt = 1; attempt <= 2; ++attempt) {
-    auto again = serve(d, "puma", "serve_again");
+  for (int restart = 1; restart <= 2; ++restart) {
+    auto restarted = serve(d, "puma", "serve_again");
     const auto until = std::chrono::steady_clock::now() + 15s;
     while (std::chrono::steady_clock::now() < until && puma.state().participant == before) {
       std::this_thread::sleep_for(20ms);
@@ -471,16 +479,20 @@ TEST(NetServe, AKilledServeFailsTheProgramsWaitWithinTheDetectionTime) {
     const rccl::Motion back = puma.move(puma.park());
     const rccl::WaitResult w = puma.waitfor(back.end(), 20s);
     const std::string failed = failures_text(puma.failures());
-    if (w != rccl::WaitResult::reached && attempt == 1 && contains(failed, "control ended") &&
-        contains(again->err(), "control ended: a control cycle did not finish")) {
+    if (w != rccl::WaitResult::reached && restart == 1 && contains(failed, "control ended") &&
+        contains(restarted->err(), "control ended: a control cycle did not finish")) {
       std::printf("the restarted serve overran its period (Debug build): once more\n");
       before = puma.state().participant;
-      again->kill9();
+      restarted->kill9();
       continue;
     }
-    EXPECT_EQ(w, rccl::WaitResult::reached) << failed << "\nserve: " << again->err();
+    EXPECT_EQ(w, rccl::WaitResult::reached) << failed << "\nserve: " << restarted->err();
     break;
   }
+}
+
+TEST(NetServe, AKilledServeFailsTheProgramsWaitWithinTheDetectionTime) {
+  test::run_with_attempts(killed_serve_once);
 }
 
 /// One attempt of the test below (a serve's overrun before the kill, which a Debug build on a
