@@ -21,6 +21,7 @@
 #include <thread>
 #include <vector>
 
+#include "net_attempts.hpp"
 #include "net_serve_helpers.hpp"
 
 extern char** environ;
@@ -148,25 +149,21 @@ TEST(NetCCell, WithoutServeProcessesTheOpenFailsWithTheServeCommandToStart) {
 /// tests and builds beside it) stalled all three processes for 80 ms once.
 constexpr int kSecureDetectionMs = 250;
 
-/// Serve processes secured with `rccx certs init`'s files: the C program joins them only with
-/// RCCX_SECURE_DIR (as participant "program"); without it, it sees no robot and cannot open.
-TEST(NetCCell, WithSecuredServesOnlyAProgramGivenRccxSecureDirJoinsThem) {
-  const std::string dir = ::testing::TempDir() + "rccx_c_certs_" + std::to_string(getpid());
-  Child certs({RCCX_EXE, "certs", "init", dir, "--participants", "puma,microbo,program"},
-              "c_certs");
-  ASSERT_TRUE(certs.started());
-  ASSERT_EQ(certs.wait_exit(120s), 0) << both(certs);
-  struct Removed {
-    std::string path;
-    ~Removed() { std::filesystem::remove_all(path); }
-  } removed{dir};
-  const std::uint32_t d = domain() + 120;  // 180 .. 219: secure domains end at 230
+/// The directory `rccx certs init` made for the test below (its attempts share it).
+std::string secure_dir;
+
+/// One attempt of the test below, on fresh serves and a domain of its own. The secured serves
+/// of a Debug build overran the cell's 7 ms in about one run in five on an idle machine (the
+/// serve's clock: its tasks woken up to 30 ms late), and in every run of two CI runs: an
+/// overrun runs it again (net_attempts.hpp), and skips it, saying so, after the third.
+void secured_once(int attempt, bool& again) {
+  const std::uint32_t d = domain() + 119 + static_cast<std::uint32_t>(attempt);  // 180 .. 221
   auto puma = rccx::test::spawn_serve(kCell, d, "puma", "c_secure_puma",
                                       std::chrono::milliseconds(kSecureDetectionMs),
-                                      {"--secure", dir, "--identity", "puma"});
+                                      {"--secure", secure_dir, "--identity", "puma"});
   auto microbo = rccx::test::spawn_serve(kCell, d, "microbo", "c_secure_microbo",
                                          std::chrono::milliseconds(kSecureDetectionMs),
-                                         {"--secure", dir, "--identity", "microbo"});
+                                         {"--secure", secure_dir, "--identity", "microbo"});
   ASSERT_TRUE(puma->started() && microbo->started());
   const std::vector<std::string> env{"RCCX_CELL=" + kCell, "RCCX_CELL_REMOTE=1",
                                      "RCCX_DOMAIN=" + std::to_string(d), "RCCX_DDS_INTERFACE=lo",
@@ -178,17 +175,39 @@ TEST(NetCCell, WithSecuredServesOnlyAProgramGivenRccxSecureDirJoinsThem) {
   EXPECT_NE(plain.out().find("open: RTC_E_OPEN"), std::string::npos) << both(plain);
 
   std::vector<std::string> secure_env = env;
-  secure_env.push_back("RCCX_SECURE_DIR=" + dir);
+  secure_env.push_back("RCCX_SECURE_DIR=" + secure_dir);
   Child secure({C_CELL_REMOTE}, "c_secure", secure_env);
   ASSERT_TRUE(secure.started());
-  const int code = secure.wait_exit(120s);
-  if (code != 0 && secure.err().find("with overrun (10)") != std::string::npos) {
-    GTEST_SKIP() << "a serve process overran its real-time period (machine too loaded):\n"
-                 << secure.err();
+  // An overrun ends the attempt at once: the program would go on failing motions until the
+  // serves stop (120 s), and three such attempts would outlast the test's time.
+  int code = -1;
+  const auto until = std::chrono::steady_clock::now() + 120s;
+  while (code == -1 && std::chrono::steady_clock::now() < until &&
+         secure.err().find("with overrun (10)") == std::string::npos) {
+    code = secure.wait_exit(100ms);
+  }
+  if (code != 0) {
+    RETRY_OR_SKIP_ON_OVERRUN(secure.err() + "\npuma serve:\n" + puma->err() + "\nmicrobo serve:\n" +
+                             microbo->err());
   }
   ASSERT_EQ(code, 0) << both(secure) << "\npuma serve:\n" << puma->err();
   EXPECT_NE(secure.out().find("open: RTC_OK"), std::string::npos) << both(secure);
   EXPECT_EQ(parse(secure.out()).times_ms.size(), 3U) << secure.out();
+}
+
+/// Serve processes secured with `rccx certs init`'s files: the C program joins them only with
+/// RCCX_SECURE_DIR (as participant "program"); without it, it sees no robot and cannot open.
+TEST(NetCCell, WithSecuredServesOnlyAProgramGivenRccxSecureDirJoinsThem) {
+  secure_dir = ::testing::TempDir() + "rccx_c_certs_" + std::to_string(getpid());
+  Child certs({RCCX_EXE, "certs", "init", secure_dir, "--participants", "puma,microbo,program"},
+              "c_certs");
+  ASSERT_TRUE(certs.started());
+  ASSERT_EQ(certs.wait_exit(120s), 0) << both(certs);
+  struct Removed {
+    std::string path;
+    ~Removed() { std::filesystem::remove_all(path); }
+  } removed{secure_dir};
+  rccx::test::run_with_attempts(secured_once);
 }
 
 TEST(NetCCell, ABadSecureDirIsRefusedNamingIt) {
