@@ -69,13 +69,16 @@ std::string both(const Child& c) {
   return "stdout:\n" + c.out() + "stderr:\n" + c.err();
 }
 
-TEST(NetCCell, TheSameCProgramRunsInOneProcessAndAcrossTwoServeProcesses) {
-  // One process: the cell as always (simulated time), no switch.
-  Child local({C_CELL_REMOTE, "together"}, "c_local", {"RCCX_CELL=" + kCell, "RCCX_CELL_REMOTE=0"});
-  ASSERT_TRUE(local.started());
-  ASSERT_EQ(local.wait_exit(120s), 0) << both(local);
+/// What the program printed in one process (simulated time), for the attempts below.
+std::string local_out;
 
-  const std::uint32_t d = domain();
+/// One attempt of the comparison below across processes, on fresh serves and a domain of its
+/// own. The serve processes run the cell's 7 ms period in real time; on a loaded machine (other
+/// builds on 2 cores, sanitizers) a cycle can overrun and end control: the C layer then says so
+/// (RTC_E_TERMINATED with the reason, checked here), the attempt ends at once and is made again
+/// (net_attempts.hpp); after the third it is skipped, saying so.
+void same_program_once(int attempt, bool& again) {
+  const std::uint32_t d = domain() + static_cast<std::uint32_t>(attempt - 1);
   auto puma = serve(d, "puma");
   auto microbo = serve(d, "microbo");
   ASSERT_TRUE(puma->started() && microbo->started());
@@ -83,21 +86,24 @@ TEST(NetCCell, TheSameCProgramRunsInOneProcessAndAcrossTwoServeProcesses) {
                {"RCCX_CELL=" + kCell, "RCCX_CELL_REMOTE=1", "RCCX_DOMAIN=" + std::to_string(d),
                 "RCCX_DDS_INTERFACE=lo", "RCCX_DETECTION_MS=" + std::to_string(kDetectionMs)});
   ASSERT_TRUE(remote.started());
-  const int code = remote.wait_exit(120s);
+  int code = -1;
+  const auto until = std::chrono::steady_clock::now() + 120s;
+  while (code == -1 && std::chrono::steady_clock::now() < until &&
+         remote.err().find("with overrun (10)") == std::string::npos) {
+    code = remote.wait_exit(100ms);
+  }
   if (code != 0 && remote.err().find("with overrun (10)") != std::string::npos) {
-    // The serve processes run the cell's 7 ms period in real time; on a loaded machine (other
-    // builds on 2 cores, sanitizers) a cycle can overrun and end control. The C layer then says
-    // so (RTC_E_TERMINATED with the reason, checked here); the comparison cannot run.
-    EXPECT_NE(remote.out().find("release: RTC_E_"), std::string::npos) << both(remote);
-    GTEST_SKIP() << "a serve process overran its real-time period (machine too loaded to compare "
-                    "the runs):\n"
-                 << remote.err();
+    if (code != -1) {
+      EXPECT_NE(remote.out().find("release: RTC_E_"), std::string::npos) << both(remote);
+    }
+    RETRY_OR_SKIP_ON_OVERRUN(remote.err() + "\npuma serve:\n" + puma->err() + "\nmicrobo serve:\n" +
+                             microbo->err());
   }
   ASSERT_EQ(code, 0) << both(remote) << "\npuma serve:\n"
                      << puma->err() << "\nmicrobo serve:\n"
                      << microbo->err();
 
-  Printed a = parse(local.out());
+  Printed a = parse(local_out);
   Printed b = parse(remote.out());
   // The one difference the program is told of: a joint start does not cross processes.
   ASSERT_FALSE(a.events.empty());
@@ -117,9 +123,9 @@ TEST(NetCCell, TheSameCProgramRunsInOneProcessAndAcrossTwoServeProcesses) {
   EXPECT_NE(remote.err().find("rccl_together: a joint start across processes"), std::string::npos)
       << remote.err();
   EXPECT_EQ(a.events, b.events) << "one process:\n"
-                                << local.out() << "across processes:\n"
+                                << local_out << "across processes:\n"
                                 << remote.out();
-  ASSERT_EQ(a.times_ms.size(), 3U) << local.out();
+  ASSERT_EQ(a.times_ms.size(), 3U) << local_out;
   ASSERT_EQ(b.times_ms.size(), a.times_ms.size()) << remote.out();
   for (std::size_t i = 0; i < a.times_ms.size(); ++i) {
     // Real time adds each request's round trip, the states' period and the program's polling;
@@ -133,6 +139,15 @@ TEST(NetCCell, TheSameCProgramRunsInOneProcessAndAcrossTwoServeProcesses) {
     std::printf("phase %zu: %ld ms in one process, %ld ms across processes\n", i + 1, a.times_ms[i],
                 b.times_ms[i]);
   }
+}
+
+TEST(NetCCell, TheSameCProgramRunsInOneProcessAndAcrossTwoServeProcesses) {
+  // One process: the cell as always (simulated time), no switch.
+  Child local({C_CELL_REMOTE, "together"}, "c_local", {"RCCX_CELL=" + kCell, "RCCX_CELL_REMOTE=0"});
+  ASSERT_TRUE(local.started());
+  ASSERT_EQ(local.wait_exit(120s), 0) << both(local);
+  local_out = local.out();
+  rccx::test::run_with_attempts(same_program_once);
 }
 
 TEST(NetCCell, WithoutServeProcessesTheOpenFailsWithTheServeCommandToStart) {
