@@ -69,6 +69,24 @@ std::string both(const Child& c) {
   return "stdout:\n" + c.out() + "stderr:\n" + c.err();
 }
 
+/// The C program's exit code, or -1 once it says its control ended by an overrun (or after
+/// 120 s): after an overrun it would go on failing motions until the serves stop (120 s), and
+/// three such attempts would outlast the test's time.
+int exit_or_overrun(Child& program) {
+  int code = -1;
+  const auto until = std::chrono::steady_clock::now() + 120s;
+  while (code == -1 && std::chrono::steady_clock::now() < until &&
+         program.err().find("with overrun (10)") == std::string::npos) {
+    code = program.wait_exit(100ms);
+  }
+  return code;
+}
+
+/// What the two serve processes said on stderr, for a failure's message.
+std::string serves_said(const Child& puma, const Child& microbo) {
+  return "\npuma serve:\n" + puma.err() + "\nmicrobo serve:\n" + microbo.err();
+}
+
 /// What the program printed in one process (simulated time), for the attempts below.
 std::string local_out;
 
@@ -86,22 +104,14 @@ void same_program_once(int attempt, bool& again) {
                {"RCCX_CELL=" + kCell, "RCCX_CELL_REMOTE=1", "RCCX_DOMAIN=" + std::to_string(d),
                 "RCCX_DDS_INTERFACE=lo", "RCCX_DETECTION_MS=" + std::to_string(kDetectionMs)});
   ASSERT_TRUE(remote.started());
-  int code = -1;
-  const auto until = std::chrono::steady_clock::now() + 120s;
-  while (code == -1 && std::chrono::steady_clock::now() < until &&
-         remote.err().find("with overrun (10)") == std::string::npos) {
-    code = remote.wait_exit(100ms);
-  }
+  const int code = exit_or_overrun(remote);
   if (code != 0 && remote.err().find("with overrun (10)") != std::string::npos) {
     if (code != -1) {
       EXPECT_NE(remote.out().find("release: RTC_E_"), std::string::npos) << both(remote);
     }
-    RETRY_OR_SKIP_ON_OVERRUN(remote.err() + "\npuma serve:\n" + puma->err() + "\nmicrobo serve:\n" +
-                             microbo->err());
+    RETRY_OR_SKIP_ON_OVERRUN(remote.err() + serves_said(*puma, *microbo));
   }
-  ASSERT_EQ(code, 0) << both(remote) << "\npuma serve:\n"
-                     << puma->err() << "\nmicrobo serve:\n"
-                     << microbo->err();
+  ASSERT_EQ(code, 0) << both(remote) << serves_said(*puma, *microbo);
 
   Printed a = parse(local_out);
   Printed b = parse(remote.out());
@@ -193,19 +203,9 @@ void secured_once(int attempt, bool& again) {
   secure_env.push_back("RCCX_SECURE_DIR=" + secure_dir);
   Child secure({C_CELL_REMOTE}, "c_secure", secure_env);
   ASSERT_TRUE(secure.started());
-  // An overrun ends the attempt at once: the program would go on failing motions until the
-  // serves stop (120 s), and three such attempts would outlast the test's time.
-  int code = -1;
-  const auto until = std::chrono::steady_clock::now() + 120s;
-  while (code == -1 && std::chrono::steady_clock::now() < until &&
-         secure.err().find("with overrun (10)") == std::string::npos) {
-    code = secure.wait_exit(100ms);
-  }
-  if (code != 0) {
-    RETRY_OR_SKIP_ON_OVERRUN(secure.err() + "\npuma serve:\n" + puma->err() + "\nmicrobo serve:\n" +
-                             microbo->err());
-  }
-  ASSERT_EQ(code, 0) << both(secure) << "\npuma serve:\n" << puma->err();
+  const int code = exit_or_overrun(secure);
+  if (code != 0) RETRY_OR_SKIP_ON_OVERRUN(secure.err() + serves_said(*puma, *microbo));
+  ASSERT_EQ(code, 0) << both(secure) << serves_said(*puma, *microbo);
   EXPECT_NE(secure.out().find("open: RTC_OK"), std::string::npos) << both(secure);
   EXPECT_EQ(parse(secure.out()).times_ms.size(), 3U) << secure.out();
 }
